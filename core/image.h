@@ -1,0 +1,33 @@
+#pragma once
+// Owned images. Depth is float metres (0 = invalid); colour is packed RGBX, 4 bytes per pixel,
+// so SIMD kernels can gather a pixel with one 32-bit load.
+#include <cstdint>
+#include <vector>
+
+namespace voxplan {
+
+template <typename T>
+struct Image {
+  int width = 0;
+  int height = 0;
+  std::vector<T> data;  // row-major, width * height
+
+  Image() = default;
+  Image(int w, int h, T fill = T{}) : width(w), height(h), data(size_t(w) * size_t(h), fill) {}
+  bool empty() const { return data.empty(); }
+  T& at(int u, int v) { return data[size_t(v) * size_t(width) + size_t(u)]; }
+  const T& at(int u, int v) const { return data[size_t(v) * size_t(width) + size_t(u)]; }
+};
+
+using DepthImage = Image<float>;
+using ColorImage = Image<uint32_t>;
+using LabelImage = Image<uint32_t>;
+
+inline uint32_t PackRgb(uint8_t r, uint8_t g, uint8_t b) {
+  return uint32_t(r) | (uint32_t(g) << 8) | (uint32_t(b) << 16);
+}
+inline uint8_t Red(uint32_t c) { return uint8_t(c & 0xff); }
+inline uint8_t Green(uint32_t c) { return uint8_t((c >> 8) & 0xff); }
+inline uint8_t Blue(uint32_t c) { return uint8_t((c >> 16) & 0xff); }
+
+}  // namespace voxplan

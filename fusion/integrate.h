@@ -1,0 +1,54 @@
+#pragma once
+// Projective TSDF integration of one RGB-D frame, in two lock-free phases: collect the blocks of
+// the truncation band (deduplicated, sorted) and allocate them serially, then update each block
+// in parallel with the scalar reference kernel or the SIMD kernel (same contract, bit-identical).
+#include <vector>
+
+#include "core/camera.h"
+#include "core/image.h"
+#include "core/pose.h"
+#include "core/status.h"
+#include "core/volume.h"
+
+namespace voxplan {
+
+enum class Weighting {
+  kConstant,        // every observation weighs 1
+  kDepthDependent,  // 1 / z^2 (z in metres), as the sensor's axial noise grows with depth
+};
+enum class Kernel { kAuto, kScalar, kSimd };
+
+struct IntegrateParams {
+  float min_depth_m = 0.1f;
+  float max_depth_m = 3.0f;
+  float max_weight = 64.0f;  // weight cap: older observations fade once reached
+  Weighting weighting = Weighting::kConstant;
+  Kernel kernel = Kernel::kAuto;
+  bool integrate_color = true;
+};
+
+struct IntegrateStats {
+  size_t blocks_in_band = 0;  // blocks updated this frame
+  size_t blocks_allocated = 0;
+  size_t valid_pixels = 0;
+  double allocate_ms = 0.0;
+  double update_ms = 0.0;
+};
+
+// depth: metres, 0 = invalid; color: empty or the same size as depth. Refuses (InvalidArgument)
+// images that do not match the camera and non-finite poses.
+Result<IntegrateStats> IntegrateFrame(const DepthImage& depth, const ColorImage& color,
+                                      const PinholeCamera& camera, const Pose3f& T_W_C,
+                                      const IntegrateParams& params, TsdfVolume& volume);
+
+// Blocks within the truncation band of every valid pixel, sorted and without duplicates.
+std::vector<BlockIndex> BlocksInTruncationBand(const DepthImage& depth, const PinholeCamera& camera,
+                                               const Pose3f& T_W_C, const IntegrateParams& params,
+                                               const VolumeParams& volume_params);
+
+// True when this CPU runs the SIMD kernel (AVX2); the one place the SIMD path is chosen.
+bool SimdKernelAvailable();
+Kernel ResolveKernel(Kernel requested);
+const char* KernelName(Kernel kernel);
+
+}  // namespace voxplan

@@ -1,0 +1,60 @@
+#pragma once
+// RGB-D dataset readers. The format is detected from the folder's files; intrinsics and depth
+// scale come from the dataset's own files unless overridden. Every error names the file (and
+// line) it came from.
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "core/camera.h"
+#include "core/image.h"
+#include "core/pose.h"
+#include "core/status.h"
+
+namespace voxplan {
+
+enum class DatasetFormat { kAuto, kTum, kIclNuim, kRedwood, kSevenScenes, kThreeDMatch, kReplica };
+
+const char* DatasetFormatName(DatasetFormat f);  // "tum", "icl", "redwood", "7scenes", ...
+Result<DatasetFormat> ParseDatasetFormat(const std::string& name);
+
+struct DatasetOptions {
+  DatasetFormat format = DatasetFormat::kAuto;
+  std::optional<PinholeCamera> intrinsics;  // overrides fx fy cx cy (size comes from the images)
+  std::optional<double> depth_scale;        // depth units per metre
+};
+
+struct DatasetInfo {
+  DatasetFormat format = DatasetFormat::kAuto;
+  std::string root;
+  PinholeCamera camera;      // width/height from the first depth image
+  double depth_scale = 0.0;  // units per metre
+  size_t num_frames = 0;
+  bool has_color = false;
+  std::string intrinsics_source;  // the file they came from, "flag" or "default (...)"
+  std::string pose_source;        // the file poses came from, or "none"
+  std::vector<std::string> warnings;  // one line each, e.g. frames dropped for lack of poses
+};
+
+struct Frame {
+  size_t index = 0;        // 0-based position in the sequence
+  double timestamp = 0.0;  // seconds (frame id or index / 30 Hz where the dataset has none)
+  DepthImage depth;        // metres, 0 = invalid
+  ColorImage color;        // empty when the dataset has no colour
+  std::optional<Pose3d> T_W_C;
+  std::string depth_path;
+};
+
+class Dataset {
+ public:
+  virtual ~Dataset() = default;
+  virtual const DatasetInfo& info() const = 0;
+  // Loads frame i (0 <= i < num_frames): decodes depth (and colour), checks sizes and bit depth.
+  virtual Result<Frame> Load(size_t i) const = 0;
+};
+
+Result<std::unique_ptr<Dataset>> OpenDataset(const std::string& path,
+                                             const DatasetOptions& options = {});
+
+}  // namespace voxplan

@@ -1,0 +1,17 @@
+#pragma once
+// Small file helpers shared by every writer and reader in io/ (and the CLI).
+#include <functional>
+#include <string>
+
+#include "core/status.h"
+
+namespace voxplan {
+
+// Calls write(tmp_path) with a temporary path in the target's folder (same extension), then
+// renames it over `path`. On any failure the temporary file is removed and `path` is untouched.
+Status WriteAtomically(const std::string& path, const std::function<Status(const std::string&)>& write);
+
+// Reads a whole file; the error names the file.
+Result<std::string> ReadFileToString(const std::string& path);
+
+}  // namespace voxplan

@@ -1,0 +1,34 @@
+#pragma once
+// Reconstruction vs ground truth, Dong et al. 2019 eq. 9-10 with area-weighted samples:
+// accuracy = distances from samples on the reconstruction to the ground-truth surface (mean, RMS),
+// completeness = fraction of ground-truth samples within `threshold_m` of the reconstruction.
+// Point-to-triangle distances through CGAL AABB trees.
+#include <cstdint>
+
+#include "core/mesh.h"
+#include "core/status.h"
+
+namespace voxplan {
+
+struct MeshEvalParams {
+  float threshold_m = 0.05f;
+  float samples_per_m2 = 10000.0f;
+  uint64_t seed = 1;
+};
+
+struct MeshEvalResult {
+  double accuracy_mean_m = 0.0;
+  double accuracy_rms_m = 0.0;
+  double accuracy_median_m = 0.0;
+  double completeness = 0.0;  // 0..1
+  double reconstruction_area_m2 = 0.0;
+  double ground_truth_area_m2 = 0.0;
+  size_t reconstruction_samples = 0;
+  size_t ground_truth_samples = 0;
+};
+
+// Refuses empty meshes.
+Result<MeshEvalResult> EvaluateMesh(const Mesh& reconstruction, const Mesh& ground_truth,
+                                    const MeshEvalParams& params = {});
+
+}  // namespace voxplan

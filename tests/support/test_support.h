@@ -1,0 +1,55 @@
+#pragma once
+// Shared helpers for the suite: analytic scenes with exact depth and SDF, seeded randomness,
+// temporary folders and the path of ../shared/data.
+#include <Eigen/Core>
+#include <filesystem>
+#include <string>
+
+#include "core/camera.h"
+#include "core/image.h"
+#include "core/pose.h"
+
+namespace voxplan::test {
+
+// ../shared/data as seen from the source tree (VOXPLAN_SHARED_DATA overrides it).
+std::filesystem::path SharedDataDir();
+// A fresh empty folder under the system temp dir, removed when the object dies.
+class TempDir {
+ public:
+  explicit TempDir(const std::string& tag = "voxplan");
+  ~TempDir();
+  const std::filesystem::path& path() const { return path_; }
+  std::filesystem::path operator/(const std::string& name) const { return path_ / name; }
+
+ private:
+  std::filesystem::path path_;
+};
+
+PinholeCamera TestCamera(int width = 160, int height = 120);
+
+// Analytic scenes: exact signed distance (positive outside the solid / in front of the plane)
+// and exact ray depth (z along the optical axis, 0 where the ray misses).
+struct Plane {  // n . p = d, normal n pointing towards free space
+  Eigen::Vector3f n;
+  float d;
+  float Sdf(const Eigen::Vector3f& p) const { return n.dot(p) - d; }
+};
+struct Sphere {
+  Eigen::Vector3f c;
+  float r;
+  float Sdf(const Eigen::Vector3f& p) const { return (p - c).norm() - r; }
+};
+struct Box {  // axis-aligned
+  Eigen::Vector3f lo, hi;
+  float Sdf(const Eigen::Vector3f& p) const;
+};
+
+DepthImage RenderDepth(const Plane& s, const PinholeCamera& cam, const Pose3f& T_W_C);
+DepthImage RenderDepth(const Sphere& s, const PinholeCamera& cam, const Pose3f& T_W_C);
+DepthImage RenderDepth(const Box& s, const PinholeCamera& cam, const Pose3f& T_W_C);
+
+// Camera at `eye` looking at `target` with world up `up` (OpenCV axes: y down in the image).
+Pose3f LookAt(const Eigen::Vector3f& eye, const Eigen::Vector3f& target,
+              const Eigen::Vector3f& up = Eigen::Vector3f::UnitZ());
+
+}  // namespace voxplan::test
