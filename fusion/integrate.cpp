@@ -1,0 +1,197 @@
+#include "fusion/integrate.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <limits>
+#include <mutex>
+#include <string>
+
+#include "core/parallel.h"
+#include "fusion/integrate_kernel.h"
+
+namespace voxplan {
+
+namespace {
+
+double MsSince(std::chrono::steady_clock::time_point t0) {
+  return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+}
+
+// Visits the blocks a world-space segment passes through (Amanatides & Woo traversal in block
+// units), so the band along one pixel ray costs a few steps instead of many point samples.
+template <typename F>
+void ForEachBlockOnSegment(const Eigen::Vector3f& a, const Eigen::Vector3f& b, float inv_block,
+                           F&& visit) {
+  const Eigen::Vector3f pa = a * inv_block, pb = b * inv_block;
+  int cell[3] = {int(std::floor(pa.x())), int(std::floor(pa.y())), int(std::floor(pa.z()))};
+  const int last[3] = {int(std::floor(pb.x())), int(std::floor(pb.y())), int(std::floor(pb.z()))};
+  const Eigen::Vector3f dir = pb - pa;
+  int step[3];
+  float t_max[3], t_delta[3];
+  for (int k = 0; k < 3; ++k) {
+    step[k] = dir[k] > 0 ? 1 : (dir[k] < 0 ? -1 : 0);
+    if (step[k] == 0) {
+      t_max[k] = t_delta[k] = std::numeric_limits<float>::infinity();
+    } else {
+      const float boundary = float(cell[k] + (step[k] > 0 ? 1 : 0));
+      t_max[k] = (boundary - pa[k]) / dir[k];
+      t_delta[k] = float(step[k]) / dir[k];
+    }
+  }
+  // Bounded: a segment crosses at most |dx|+|dy|+|dz|+1 cells; guards against float drift.
+  const int max_steps = std::abs(last[0] - cell[0]) + std::abs(last[1] - cell[1]) +
+                        std::abs(last[2] - cell[2]) + 1;
+  for (int i = 0; i < max_steps; ++i) {
+    visit(BlockIndex{cell[0], cell[1], cell[2]});
+    if (cell[0] == last[0] && cell[1] == last[1] && cell[2] == last[2]) break;
+    const int k = (t_max[0] < t_max[1]) ? (t_max[0] < t_max[2] ? 0 : 2) : (t_max[1] < t_max[2] ? 1 : 2);
+    cell[k] += step[k];
+    t_max[k] += t_delta[k];
+  }
+}
+
+Status ValidateParams(const IntegrateParams& p) {
+  if (!(p.min_depth_m >= 0.f && p.max_depth_m > p.min_depth_m && std::isfinite(p.max_depth_m)))
+    return InvalidArgument("depth range must satisfy 0 <= min < max, got [" +
+                           std::to_string(p.min_depth_m) + ", " + std::to_string(p.max_depth_m) + "]");
+  if (!(p.max_weight > 0.f && p.max_weight <= kMaxWeight))
+    return InvalidArgument("max weight must be in (0, " + std::to_string(kMaxWeight) + "], got " +
+                           std::to_string(p.max_weight));
+  return Status::Ok();
+}
+
+}  // namespace
+
+bool SimdKernelAvailable() {
+#if defined(__x86_64__)
+  return __builtin_cpu_supports("avx2");
+#else
+  return false;
+#endif
+}
+
+Kernel ResolveKernel(Kernel requested) {
+  if (requested == Kernel::kAuto) return SimdKernelAvailable() ? Kernel::kSimd : Kernel::kScalar;
+  if (requested == Kernel::kSimd && !SimdKernelAvailable()) return Kernel::kScalar;
+  return requested;
+}
+
+const char* KernelName(Kernel kernel) {
+  switch (kernel) {
+    case Kernel::kAuto: return "auto";
+    case Kernel::kScalar: return "scalar";
+    case Kernel::kSimd: return "avx2";
+  }
+  return "?";
+}
+
+std::vector<BlockIndex> BlocksInTruncationBand(const DepthImage& depth, const PinholeCamera& camera,
+                                               const Pose3f& T_W_C, const IntegrateParams& params,
+                                               const VolumeParams& volume_params) {
+  const float trunc = volume_params.trunc_m;
+  const float inv_block = 1.0f / (volume_params.voxel_size_m * kBlockSide);
+  const Eigen::Matrix3f R = T_W_C.linear();
+  const Eigen::Vector3f t = T_W_C.translation();
+
+  std::vector<uint64_t> keys;
+  std::mutex keys_mutex;
+  constexpr size_t kRowsPerTask = 8;
+  const size_t tasks = (size_t(depth.height) + kRowsPerTask - 1) / kRowsPerTask;
+  ParallelFor(tasks, 1, [&](size_t begin, size_t end) {
+    // Neighbouring pixels hit the same blocks: a small direct-mapped cache drops most repeats
+    // before the global sort.
+    constexpr size_t kCache = 1024;
+    std::vector<uint64_t> cache(kCache, ~0ull);
+    std::vector<uint64_t> local;
+    for (size_t task = begin; task < end; ++task) {
+      const int v_end = std::min<int>(depth.height, int((task + 1) * kRowsPerTask));
+      for (int v = int(task * kRowsPerTask); v < v_end; ++v) {
+        for (int u = 0; u < depth.width; ++u) {
+          const float d = depth.at(u, v);
+          if (!(d >= params.min_depth_m && d <= params.max_depth_m)) continue;
+          const Eigen::Vector3f ray_C = camera.Unproject(float(u), float(v), 1.0f);
+          const Eigen::Vector3f a = R * (ray_C * std::max(d - trunc, 1e-3f)) + t;
+          const Eigen::Vector3f b = R * (ray_C * (d + trunc)) + t;
+          ForEachBlockOnSegment(a, b, inv_block, [&](BlockIndex block) {
+            if (!InPackRange(block)) return;
+            const uint64_t key = PackBlockIndex(block);
+            uint64_t& slot = cache[(key ^ (key >> 21) ^ (key >> 42)) & (kCache - 1)];
+            if (slot == key) return;
+            slot = key;
+            local.push_back(key);
+          });
+        }
+      }
+    }
+    std::lock_guard<std::mutex> lock(keys_mutex);
+    keys.insert(keys.end(), local.begin(), local.end());
+  });
+  std::sort(keys.begin(), keys.end());
+  keys.erase(std::unique(keys.begin(), keys.end()), keys.end());
+  std::vector<BlockIndex> blocks(keys.size());
+  std::transform(keys.begin(), keys.end(), blocks.begin(), UnpackBlockIndex);
+  std::sort(blocks.begin(), blocks.end());
+  return blocks;
+}
+
+Result<IntegrateStats> IntegrateFrame(const DepthImage& depth, const ColorImage& color,
+                                      const PinholeCamera& camera, const Pose3f& T_W_C,
+                                      const IntegrateParams& params, TsdfVolume& volume) {
+  VOXPLAN_RETURN_IF_ERROR(ValidateParams(params));
+  if (!camera.Valid()) return InvalidArgument("camera intrinsics are invalid");
+  if (depth.width != camera.width || depth.height != camera.height)
+    return InvalidArgument("depth image is " + std::to_string(depth.width) + "x" +
+                           std::to_string(depth.height) + " but the camera is " +
+                           std::to_string(camera.width) + "x" + std::to_string(camera.height));
+  if (!color.empty() && (color.width != depth.width || color.height != depth.height))
+    return InvalidArgument("colour image size differs from the depth image size");
+  if (!T_W_C.matrix().allFinite()) return InvalidArgument("camera pose has NaN or infinite values");
+
+  IntegrateStats stats;
+  auto t0 = std::chrono::steady_clock::now();
+  const std::vector<BlockIndex> band =
+      BlocksInTruncationBand(depth, camera, T_W_C, params, volume.params());
+  std::vector<TsdfBlock*> blocks(band.size());
+  for (size_t i = 0; i < band.size(); ++i) {
+    bool created = false;
+    blocks[i] = &volume.FindOrAllocate(band[i], &created);
+    stats.blocks_allocated += created ? 1 : 0;
+  }
+  stats.blocks_in_band = band.size();
+  stats.allocate_ms = MsSince(t0);
+
+  t0 = std::chrono::steady_clock::now();
+  internal::FrameView f;
+  f.depth = depth.data.data();
+  f.color = (params.integrate_color && !color.empty()) ? color.data.data() : nullptr;
+  f.width = depth.width;
+  f.height = depth.height;
+  f.fx = camera.fx;
+  f.fy = camera.fy;
+  f.cx = camera.cx;
+  f.cy = camera.cy;
+  const Pose3f T_C_W = T_W_C.inverse();
+  for (int r = 0; r < 3; ++r) {
+    for (int c = 0; c < 3; ++c) f.r[3 * r + c] = T_C_W.linear()(r, c);
+    f.t[r] = T_C_W.translation()[r];
+  }
+  f.min_depth_m = params.min_depth_m;
+  f.max_depth_m = params.max_depth_m;
+  f.trunc_m = volume.trunc_m();
+  f.inv_trunc = 1.0f / volume.trunc_m();
+  f.voxel_size_m = volume.voxel_size_m();
+  f.max_weight = params.max_weight;
+  f.depth_weighting = params.weighting == Weighting::kDepthDependent;
+
+  const auto kernel = ResolveKernel(params.kernel) == Kernel::kSimd ? internal::IntegrateBlockSimd
+                                                                    : internal::IntegrateBlockScalar;
+  ParallelFor(band.size(), 16, [&](size_t begin, size_t end) {
+    for (size_t i = begin; i < end; ++i) kernel(f, band[i], *blocks[i]);
+  });
+  stats.update_ms = MsSince(t0);
+  for (float d : depth.data) stats.valid_pixels += (d >= params.min_depth_m && d <= params.max_depth_m);
+  return stats;
+}
+
+}  // namespace voxplan

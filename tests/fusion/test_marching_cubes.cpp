@@ -1,0 +1,117 @@
+// Marching cubes on exact signed distance fields: closed, on the surface, right area, normals out.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <map>
+
+#include "fusion/marching_cubes_table.h"
+#include "fusion/mesh_extract.h"
+#include "tests/support/test_support.h"
+
+namespace voxplan {
+namespace {
+
+// Writes an exact SDF into every voxel of the blocks within `band_m` of the surface.
+template <typename Sdf>
+TsdfVolume FillExact(const Sdf& sdf, float voxel, float trunc, const Eigen::Vector3f& lo,
+                     const Eigen::Vector3f& hi) {
+  TsdfVolume volume({voxel, trunc});
+  const float block = voxel * kBlockSide;
+  const BlockIndex b0 = BlockAt(lo, block), b1 = BlockAt(hi, block);
+  for (int z = b0.z; z <= b1.z; ++z)
+    for (int y = b0.y; y <= b1.y; ++y)
+      for (int x = b0.x; x <= b1.x; ++x) {
+        const BlockIndex b{x, y, z};
+        const Eigen::Vector3f centre = BlockOrigin(b, block) + Eigen::Vector3f::Constant(block / 2);
+        if (std::abs(sdf(centre)) > block + trunc) continue;
+        TsdfBlock& data = volume.FindOrAllocate(b);
+        for (int i = 0; i < kBlockVoxels; ++i) {
+          const float d = sdf(VoxelCenter(GlobalOf(b, VoxelOfLinear(i)), voxel));
+          data.tsdf[i] = EncodeTsdf(d / trunc);
+          data.weight[i] = EncodeWeight(1.0f);
+          data.r[i] = 10;
+          data.g[i] = 20;
+          data.b[i] = 30;
+        }
+      }
+  return volume;
+}
+
+// Every undirected edge used by exactly two triangles, in opposite directions.
+void ExpectClosedAndConsistentlyOriented(const Mesh& mesh) {
+  std::map<std::pair<uint32_t, uint32_t>, int> directed;
+  for (const auto& t : mesh.triangles)
+    for (int k = 0; k < 3; ++k) directed[{t[k], t[(k + 1) % 3]}]++;
+  size_t bad = 0;
+  for (const auto& [e, n] : directed) {
+    const auto it = directed.find({e.second, e.first});
+    bad += (n != 1 || it == directed.end() || it->second != 1);
+  }
+  EXPECT_EQ(bad, 0u) << "edges not shared by exactly two opposite triangles";
+}
+
+TEST(MarchingCubes, TableCoversEveryCaseConsistently) {
+  const auto& table = internal::MarchingCubesTable();
+  EXPECT_EQ(table[0].num_triangles, 0);
+  EXPECT_EQ(table[255].num_triangles, 0);
+  for (int i = 1; i < 255; ++i) {
+    EXPECT_GT(table[i].num_triangles, 0) << "case " << i;
+    EXPECT_LE(table[i].num_triangles, 12) << "case " << i;
+  }
+  EXPECT_EQ(table[1].num_triangles, 1);    // one corner inside: one triangle
+  EXPECT_EQ(table[3].num_triangles, 2);    // one edge inside: a quad
+  EXPECT_EQ(table[15].num_triangles, 2);   // half the cube: a quad
+}
+
+TEST(MarchingCubes, SphereIsClosedOnTheSurfaceWithTheRightArea) {
+  const Eigen::Vector3f c(0.013f, -0.021f, 0.007f);
+  const float r = 0.3f, voxel = 0.01f;
+  auto sdf = [&](const Eigen::Vector3f& p) { return (p - c).norm() - r; };
+  const TsdfVolume volume = FillExact(sdf, voxel, 4 * voxel, c - Eigen::Vector3f::Constant(0.5f),
+                                      c + Eigen::Vector3f::Constant(0.5f));
+  const Mesh mesh = ExtractMesh(volume);
+  ASSERT_GT(mesh.num_triangles(), 1000u);
+  ExpectClosedAndConsistentlyOriented(mesh);
+
+  double area = 0.0;
+  for (const auto& t : mesh.triangles)
+    area += 0.5 * (mesh.positions[t[1]] - mesh.positions[t[0]])
+                      .cross(mesh.positions[t[2]] - mesh.positions[t[0]])
+                      .norm();
+  const double true_area = 4.0 * M_PI * r * r;
+  EXPECT_NEAR(area / true_area, 1.0, 0.01);  // within 1 %
+
+  constexpr float kMaxDistanceVox = 0.05f;  // linear interpolation of an exact SDF
+  float worst = 0.f, worst_normal = 1.f;
+  for (size_t i = 0; i < mesh.positions.size(); ++i) {
+    worst = std::max(worst, std::abs(sdf(mesh.positions[i])));
+    worst_normal = std::min(worst_normal, mesh.normals[i].dot((mesh.positions[i] - c).normalized()));
+  }
+  EXPECT_LT(worst, kMaxDistanceVox * voxel);
+  EXPECT_GT(worst_normal, 0.98f) << "normals point outwards";
+  ASSERT_EQ(mesh.colors.size(), mesh.positions.size());
+  EXPECT_EQ(mesh.colors[0], (std::array<uint8_t, 3>{10, 20, 30}));
+}
+
+TEST(MarchingCubes, UnobservedVoxelsProduceNothing) {
+  auto sdf = [](const Eigen::Vector3f& p) { return p.z() - 0.0123f; };
+  TsdfVolume volume = FillExact(sdf, 0.02f, 0.08f, Eigen::Vector3f(-0.3f, -0.3f, -0.2f),
+                                Eigen::Vector3f(0.3f, 0.3f, 0.2f));
+  const size_t full = ExtractMesh(volume).num_triangles();
+  ASSERT_GT(full, 0u);
+  volume.ForEachBlock([&](BlockIndex, const TsdfBlock&) {});
+  for (const BlockIndex& b : volume.SortedBlockIndices()) {
+    TsdfBlock* block = volume.FindBlock(b);
+    for (int i = 0; i < kBlockVoxels; ++i)
+      if (b.x >= 0) block->weight[i] = 0;
+  }
+  MeshParams params;
+  const size_t half = ExtractMesh(volume, params).num_triangles();
+  EXPECT_GT(half, 0u);
+  EXPECT_LT(half, full * 6 / 10);
+  params.min_weight = 2.0f;  // every voxel has weight 1: all skipped
+  EXPECT_EQ(ExtractMesh(volume, params).num_triangles(), 0u);
+}
+
+}  // namespace
+}  // namespace voxplan
