@@ -2,6 +2,7 @@
 // Small file helpers shared by every writer and reader in io/ (and the CLI).
 #include <functional>
 #include <string>
+#include <string_view>
 
 #include "core/status.h"
 
@@ -9,7 +10,11 @@ namespace voxplan {
 
 // Calls write(tmp_path) with a temporary path in the target's folder (same extension), then
 // renames it over `path`. On any failure the temporary file is removed and `path` is untouched.
-Status WriteAtomically(const std::string& path, const std::function<Status(const std::string&)>& write);
+Status WriteAtomically(const std::string& path,
+                       const std::function<Status(const std::string&)>& write);
+
+// Writes `data` to `path` in one go (not atomic: use inside WriteAtomically's callback).
+Status WriteStringToFile(const std::string& path, std::string_view data);
 
 // Reads a whole file; the error names the file.
 Result<std::string> ReadFileToString(const std::string& path);

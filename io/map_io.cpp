@@ -1,0 +1,239 @@
+#include "io/map_io.h"
+
+#include <bit>
+#include <cerrno>
+#include <cmath>
+#include <cstdio>
+#include <cstring>
+#include <filesystem>
+#include <memory>
+#include <optional>
+#include <type_traits>
+
+#include "io/file_util.h"
+
+namespace voxplan {
+
+// The format is the in-memory layout of little-endian hosts; a big-endian build would need
+// byte swapping here.
+static_assert(std::endian::native == std::endian::little, "map files assume a little-endian host");
+
+namespace {
+
+constexpr char kMagic[8] = {'V', 'X', 'P', 'L', 'M', 'A', 'P', '\0'};
+constexpr size_t kHeaderBytes = 8 + 4 + 4 + 4 + 8;
+constexpr size_t kBlockRecordBytes = 3 * sizeof(int32_t) + sizeof(TsdfBlock);
+constexpr size_t kChecksumBytes = 8;
+static_assert(sizeof(kMagic) == 8);
+
+// FNV-1a 64, updated as bytes stream past so neither save nor load holds a second copy.
+class Fnv1a64 {
+ public:
+  void Update(const void* data, size_t n) {
+    const auto* p = static_cast<const unsigned char*>(data);
+    uint64_t h = hash_;
+    for (size_t i = 0; i < n; ++i) h = (h ^ p[i]) * 0x100000001b3ull;
+    hash_ = h;
+  }
+  uint64_t value() const { return hash_; }
+
+ private:
+  uint64_t hash_ = 0xcbf29ce484222325ull;
+};
+
+struct FileCloser {
+  void operator()(std::FILE* f) const { std::fclose(f); }
+};
+using File = std::unique_ptr<std::FILE, FileCloser>;
+
+template <typename T>
+void Put(std::string& out, const T& v) {
+  static_assert(std::is_trivially_copyable_v<T>);
+  out.append(reinterpret_cast<const char*>(&v), sizeof(T));
+}
+template <typename T>
+T Get(const char* p) {
+  T v;
+  std::memcpy(&v, p, sizeof(T));
+  return v;
+}
+
+std::string BlockName(BlockIndex b) {
+  // Appended piecewise: `"(" + std::to_string(...)` trips a false -Wrestrict in GCC 12.
+  std::string s = "(";
+  s += std::to_string(b.x);
+  s += ", ";
+  s += std::to_string(b.y);
+  s += ", ";
+  s += std::to_string(b.z);
+  s += ")";
+  return s;
+}
+
+Status CheckParams(const VolumeParams& p) {
+  if (!(std::isfinite(p.voxel_size_m) && p.voxel_size_m > 0.0f))
+    return CorruptData("invalid voxel size " + std::to_string(p.voxel_size_m) + " m");
+  if (!(std::isfinite(p.trunc_m) && p.trunc_m >= p.voxel_size_m))
+    return CorruptData("invalid truncation " + std::to_string(p.trunc_m) + " m for voxel size " +
+                       std::to_string(p.voxel_size_m) + " m");
+  return Status::Ok();
+}
+
+// Parses and checks the header against the file's size. Messages name what is wrong; callers
+// add the file name.
+Result<MapHeader> ParseHeader(const char* bytes, size_t available, uint64_t file_size) {
+  if (available < kHeaderBytes || file_size < kHeaderBytes)
+    return CorruptData("truncated: " + std::to_string(file_size) +
+                       " bytes, shorter than the map header");
+  if (std::memcmp(bytes, kMagic, sizeof(kMagic)) != 0)
+    return CorruptData("not a voxplan map (bad magic)");
+  MapHeader header;
+  header.version = Get<uint32_t>(bytes + 8);
+  if (header.version != kMapFormatVersion)
+    return Unsupported("format version " + std::to_string(header.version) +
+                       ", this build reads version " + std::to_string(kMapFormatVersion));
+  header.params.voxel_size_m = Get<float>(bytes + 12);
+  header.params.trunc_m = Get<float>(bytes + 16);
+  header.num_blocks = Get<uint64_t>(bytes + 20);
+  VOXPLAN_RETURN_IF_ERROR(CheckParams(header.params));
+  // Compared by division first so a corrupt count cannot overflow the expected size.
+  const uint64_t payload = file_size - kHeaderBytes;
+  const bool too_many = header.num_blocks > payload / kBlockRecordBytes;
+  const uint64_t expected =
+      too_many ? 0 : kHeaderBytes + header.num_blocks * kBlockRecordBytes + kChecksumBytes;
+  if (too_many || file_size < expected)
+    return CorruptData("truncated: the header announces " + std::to_string(header.num_blocks) +
+                       " blocks but the file has only " + std::to_string(file_size) + " bytes");
+  if (file_size != expected)
+    return CorruptData("the header announces " + std::to_string(header.num_blocks) + " blocks (" +
+                       std::to_string(expected) + " bytes) but the file has " +
+                       std::to_string(file_size) + " bytes");
+  return header;
+}
+
+Result<uint64_t> FileSize(const std::string& path) {
+  std::error_code ec;
+  if (!std::filesystem::is_regular_file(path, ec)) return NotFound("no such map file: " + path);
+  const uintmax_t size = std::filesystem::file_size(path, ec);
+  if (ec) return IoError("cannot stat " + path + ": " + ec.message());
+  return uint64_t(size);
+}
+
+Result<File> OpenForReading(const std::string& path) {
+  File f(std::fopen(path.c_str(), "rb"));
+  if (!f) return IoError("cannot open " + path + ": " + std::strerror(errno));
+  return f;
+}
+
+Status WriteMapFile(const TsdfVolume& volume, const std::vector<BlockIndex>& blocks,
+                    const std::string& path) {
+  File f(std::fopen(path.c_str(), "wb"));
+  if (!f) return IoError("cannot open " + path + " for writing: " + std::strerror(errno));
+  Fnv1a64 hash;
+  std::string buffer;
+  buffer.reserve(size_t(1) << 20);
+  auto flush = [&]() -> bool {
+    hash.Update(buffer.data(), buffer.size());
+    const bool ok = std::fwrite(buffer.data(), 1, buffer.size(), f.get()) == buffer.size();
+    buffer.clear();
+    return ok;
+  };
+  buffer.append(kMagic, sizeof(kMagic));
+  Put(buffer, kMapFormatVersion);
+  Put(buffer, volume.params().voxel_size_m);
+  Put(buffer, volume.params().trunc_m);
+  Put(buffer, uint64_t(blocks.size()));
+  for (const BlockIndex& b : blocks) {
+    const TsdfBlock* block = volume.FindBlock(b);
+    assert(block);
+    Put(buffer, b.x);
+    Put(buffer, b.y);
+    Put(buffer, b.z);
+    buffer.append(reinterpret_cast<const char*>(block), sizeof(TsdfBlock));
+    if (buffer.size() >= (size_t(1) << 20) && !flush())
+      return IoError("cannot write " + path + ": " + std::strerror(errno));
+  }
+  if (!flush()) return IoError("cannot write " + path + ": " + std::strerror(errno));
+  Put(buffer, hash.value());
+  if (std::fwrite(buffer.data(), 1, buffer.size(), f.get()) != buffer.size())
+    return IoError("cannot write " + path + ": " + std::strerror(errno));
+  if (std::fclose(f.release()) != 0)
+    return IoError("cannot write " + path + ": " + std::strerror(errno));
+  return Status::Ok();
+}
+
+}  // namespace
+
+Status SaveMap(const TsdfVolume& volume, const std::string& path) {
+  const std::vector<BlockIndex> blocks = volume.SortedBlockIndices();
+  return WriteAtomically(path,
+                         [&](const std::string& tmp) { return WriteMapFile(volume, blocks, tmp); });
+}
+
+Result<MapHeader> ReadMapHeader(const std::string& path) {
+  const Result<uint64_t> size = FileSize(path);
+  if (!size.ok()) return size.status();
+  Result<File> f = OpenForReading(path);
+  if (!f.ok()) return f.status();
+  char bytes[kHeaderBytes];
+  const size_t got = std::fread(bytes, 1, sizeof(bytes), f->get());
+  Result<MapHeader> header = ParseHeader(bytes, got, *size);
+  if (!header.ok()) return header.status().WithContext("map " + path);
+  return header;
+}
+
+Result<TsdfVolume> LoadMap(const std::string& path) {
+  const Result<uint64_t> size = FileSize(path);
+  if (!size.ok()) return size.status();
+  Result<File> file = OpenForReading(path);
+  if (!file.ok()) return file.status();
+  std::FILE* f = file->get();
+  const std::string context = "map " + path;
+
+  Fnv1a64 hash;
+  char header_bytes[kHeaderBytes];
+  const size_t got = std::fread(header_bytes, 1, sizeof(header_bytes), f);
+  const Result<MapHeader> header = ParseHeader(header_bytes, got, *size);
+  if (!header.ok()) return header.status().WithContext(context);
+  hash.Update(header_bytes, sizeof(header_bytes));
+
+  // Blocks stream straight into the volume. Structural problems are remembered rather than
+  // returned at once, so a damaged file is reported as a checksum mismatch (the likelier cause)
+  // when the checksum disagrees too.
+  TsdfVolume volume(header->params);
+  std::optional<Status> problem;
+  std::optional<BlockIndex> previous;
+  char index_bytes[3 * sizeof(int32_t)];
+  TsdfBlock scratch;
+  for (uint64_t i = 0; i < header->num_blocks; ++i) {
+    if (std::fread(index_bytes, 1, sizeof(index_bytes), f) != sizeof(index_bytes))
+      return IoError("cannot read " + path + ": short read in block " + std::to_string(i));
+    hash.Update(index_bytes, sizeof(index_bytes));
+    const BlockIndex b{Get<int32_t>(index_bytes), Get<int32_t>(index_bytes + 4),
+                       Get<int32_t>(index_bytes + 8)};
+    if (!problem) {
+      if (!InPackRange(b))
+        problem = CorruptData("block " + std::to_string(i) + " index " + BlockName(b) +
+                              " is out of range");
+      else if (previous && *previous == b)
+        problem = CorruptData("duplicate block " + BlockName(b));
+      else if (previous && b < *previous)
+        problem = CorruptData("block " + BlockName(b) + " is out of sorted order");
+    }
+    previous = b;
+    TsdfBlock& dst = problem ? scratch : volume.FindOrAllocate(b);
+    if (std::fread(&dst, 1, sizeof(TsdfBlock), f) != sizeof(TsdfBlock))
+      return IoError("cannot read " + path + ": short read in block " + std::to_string(i));
+    hash.Update(&dst, sizeof(TsdfBlock));
+  }
+  char checksum_bytes[kChecksumBytes];
+  if (std::fread(checksum_bytes, 1, sizeof(checksum_bytes), f) != sizeof(checksum_bytes))
+    return IoError("cannot read " + path + ": short read in the checksum");
+  const uint64_t stored = Get<uint64_t>(checksum_bytes);
+  if (stored != hash.value())
+    return CorruptData("checksum mismatch (the file is damaged)").WithContext(context);
+  if (problem) return problem->WithContext(context);
+  return volume;
+}
+
+}  // namespace voxplan

@@ -1,0 +1,270 @@
+#include "io/mesh_io.h"
+
+#include <assimp/material.h>
+#include <assimp/postprocess.h>
+#include <assimp/scene.h>
+
+#include <algorithm>
+#include <assimp/Exporter.hpp>
+#include <assimp/Importer.hpp>
+#include <bit>
+#include <cctype>
+#include <cmath>
+#include <cstring>
+#include <filesystem>
+#include <memory>
+
+#include "io/file_util.h"
+
+namespace voxplan {
+
+namespace {
+
+std::string LowerExtension(const std::string& path) {
+  std::string ext = std::filesystem::path(path).extension().string();
+  std::transform(ext.begin(), ext.end(), ext.begin(),
+                 [](unsigned char c) { return char(std::tolower(c)); });
+  return ext;
+}
+
+uint8_t ToByte(float c) {
+  if (!std::isfinite(c)) return 0;
+  return uint8_t(std::lround(std::clamp(c, 0.0f, 1.0f) * 255.0f));
+}
+
+// Importers invent a material when a file has none ("DefaultMaterial", or an unnamed white one
+// for PLY and STL, which have no materials of their own); that is not the file's colour.
+bool MaterialDiffuse(const aiScene& scene, unsigned int index, bool format_has_materials,
+                     aiColor4D* color) {
+  if (!format_has_materials) return false;
+  if (index >= scene.mNumMaterials || !scene.mMaterials[index]) return false;
+  const aiMaterial& material = *scene.mMaterials[index];
+  aiString name;
+  if (material.Get(AI_MATKEY_NAME, name) == AI_SUCCESS &&
+      std::strcmp(name.C_Str(), AI_DEFAULT_MATERIAL_NAME) == 0)
+    return false;
+  return material.Get(AI_MATKEY_COLOR_DIFFUSE, *color) == AI_SUCCESS;
+}
+
+// Binary little-endian PLY written directly: assimp's PLY exporter stores colours as floats
+// (r, g, b, a), which most tools read as non-standard properties; uchar red/green/blue is what
+// MeshLab, Open3D and assimp itself expect.
+std::string EncodePly(const Mesh& mesh) {
+  static_assert(std::endian::native == std::endian::little, "PLY writer assumes little-endian");
+  const bool has_normals = mesh.normals.size() == mesh.positions.size() && !mesh.normals.empty();
+  const bool has_colors = mesh.colors.size() == mesh.positions.size() && !mesh.colors.empty();
+  std::string out = "ply\nformat binary_little_endian 1.0\ncomment written by voxplan\n";
+  out += "element vertex " + std::to_string(mesh.num_vertices()) + "\n";
+  out += "property float x\nproperty float y\nproperty float z\n";
+  if (has_normals) out += "property float nx\nproperty float ny\nproperty float nz\n";
+  if (has_colors) out += "property uchar red\nproperty uchar green\nproperty uchar blue\n";
+  out += "element face " + std::to_string(mesh.num_triangles()) + "\n";
+  out += "property list uchar uint vertex_indices\nend_header\n";
+  const size_t vertex_bytes = 12 + (has_normals ? 12 : 0) + (has_colors ? 3 : 0);
+  const size_t header_bytes = out.size();
+  out.resize(header_bytes + vertex_bytes * mesh.num_vertices() + 13 * mesh.num_triangles());
+  char* dst = out.data() + header_bytes;
+  for (size_t v = 0; v < mesh.num_vertices(); ++v) {
+    std::memcpy(dst, mesh.positions[v].data(), 12);
+    dst += 12;
+    if (has_normals) {
+      std::memcpy(dst, mesh.normals[v].data(), 12);
+      dst += 12;
+    }
+    if (has_colors) {
+      std::memcpy(dst, mesh.colors[v].data(), 3);
+      dst += 3;
+    }
+  }
+  for (const auto& t : mesh.triangles) {
+    *dst++ = 3;
+    std::memcpy(dst, t.data(), 12);
+    dst += 12;
+  }
+  return out;
+}
+
+// A one-mesh, one-node scene for assimp's exporters. The material is named like assimp's own
+// default so that reading the file back does not turn it into a uniform colour.
+std::unique_ptr<aiScene> MakeScene(const Mesh& mesh) {
+  auto scene = std::make_unique<aiScene>();
+  scene->mFlags = AI_SCENE_FLAGS_NON_VERBOSE_FORMAT;  // vertices are shared between faces
+  scene->mRootNode = new aiNode("root");
+  scene->mRootNode->mNumMeshes = 1;
+  scene->mRootNode->mMeshes = new unsigned int[1]{0};
+  scene->mNumMaterials = 1;
+  scene->mMaterials = new aiMaterial*[1];
+  scene->mMaterials[0] = new aiMaterial();
+  aiString name(AI_DEFAULT_MATERIAL_NAME);
+  scene->mMaterials[0]->AddProperty(&name, AI_MATKEY_NAME);
+  scene->mNumMeshes = 1;
+  scene->mMeshes = new aiMesh*[1];
+  aiMesh* m = scene->mMeshes[0] = new aiMesh();
+  m->mPrimitiveTypes = aiPrimitiveType_TRIANGLE;
+  m->mMaterialIndex = 0;
+  m->mNumVertices = unsigned(mesh.num_vertices());
+  m->mVertices = new aiVector3D[m->mNumVertices];
+  for (unsigned v = 0; v < m->mNumVertices; ++v) {
+    const auto& p = mesh.positions[v];
+    m->mVertices[v] = aiVector3D(p.x(), p.y(), p.z());
+  }
+  if (!mesh.normals.empty() && mesh.normals.size() == mesh.positions.size()) {
+    m->mNormals = new aiVector3D[m->mNumVertices];
+    for (unsigned v = 0; v < m->mNumVertices; ++v) {
+      const auto& n = mesh.normals[v];
+      m->mNormals[v] = aiVector3D(n.x(), n.y(), n.z());
+    }
+  }
+  if (!mesh.colors.empty() && mesh.colors.size() == mesh.positions.size()) {
+    m->mColors[0] = new aiColor4D[m->mNumVertices];
+    for (unsigned v = 0; v < m->mNumVertices; ++v) {
+      const auto& c = mesh.colors[v];
+      m->mColors[0][v] = aiColor4D(c[0] / 255.0f, c[1] / 255.0f, c[2] / 255.0f, 1.0f);
+    }
+  }
+  m->mNumFaces = unsigned(mesh.num_triangles());
+  m->mFaces = new aiFace[m->mNumFaces];
+  for (unsigned f = 0; f < m->mNumFaces; ++f) {
+    m->mFaces[f].mNumIndices = 3;
+    m->mFaces[f].mIndices = new unsigned int[3];
+    for (int k = 0; k < 3; ++k) m->mFaces[f].mIndices[k] = mesh.triangles[f][k];
+  }
+  return scene;
+}
+
+Status CheckMesh(const Mesh& mesh) {
+  if (mesh.empty()) return InvalidArgument("the mesh has no triangles");
+  if (!mesh.normals.empty() && mesh.normals.size() != mesh.positions.size())
+    return InvalidArgument("the mesh has " + std::to_string(mesh.normals.size()) + " normals for " +
+                           std::to_string(mesh.positions.size()) + " vertices");
+  if (!mesh.colors.empty() && mesh.colors.size() != mesh.positions.size())
+    return InvalidArgument("the mesh has " + std::to_string(mesh.colors.size()) + " colours for " +
+                           std::to_string(mesh.positions.size()) + " vertices");
+  if (mesh.num_vertices() > size_t(UINT32_MAX) || mesh.num_triangles() > size_t(UINT32_MAX))
+    return Unsupported("the mesh is too large for 32-bit indices");
+  for (const auto& t : mesh.triangles)
+    for (uint32_t i : t)
+      if (i >= mesh.num_vertices())
+        return InvalidArgument("triangle index " + std::to_string(i) + " is out of range (" +
+                               std::to_string(mesh.num_vertices()) + " vertices)");
+  return Status::Ok();
+}
+
+}  // namespace
+
+Status WriteMesh(const Mesh& mesh, const std::string& path) {
+  const std::string ext = LowerExtension(path);
+  const char* format = nullptr;
+  if (ext == ".obj") {
+    format = "objnomtl";  // one file: the .mtl of "obj" would be named after the temp file
+  } else if (ext == ".glb") {
+    format = "glb2";
+  } else if (ext == ".stl") {
+    format = "stlb";
+  } else if (ext != ".ply") {
+    return InvalidArgument("cannot write mesh " + path + ": unsupported extension '" + ext +
+                           "' (use .ply, .obj, .glb or .stl)");
+  }
+  VOXPLAN_RETURN_IF_ERROR(CheckMesh(mesh).WithContext("cannot write mesh " + path));
+
+  std::string bytes;
+  if (!format) {
+    bytes = EncodePly(mesh);
+  } else {
+    // Export to memory, then write the bytes ourselves so the atomic rename covers them.
+    const std::unique_ptr<aiScene> scene = MakeScene(mesh);
+    Assimp::Exporter exporter;
+    const aiExportDataBlob* blob = exporter.ExportToBlob(scene.get(), format);
+    if (!blob)
+      return IoError("cannot write mesh " + path + ": assimp: " + exporter.GetErrorString());
+    if (blob->next)
+      return Status(StatusCode::kInternal,
+                    "cannot write mesh " + path + ": assimp produced more than one file");
+    bytes.assign(static_cast<const char*>(blob->data), blob->size);
+  }
+  return WriteAtomically(path,
+                         [&](const std::string& tmp) { return WriteStringToFile(tmp, bytes); });
+}
+
+bool IsSupportedMeshExtension(const std::string& path) {
+  const std::string ext = LowerExtension(path);
+  return ext == ".ply" || ext == ".obj" || ext == ".glb" || ext == ".stl";
+}
+
+Result<Mesh> ReadMesh(const std::string& path, const MeshReadOptions& options) {
+  if (!(std::isfinite(options.scale) && options.scale > 0.0f))
+    return InvalidArgument("reading " + path + ": scale must be positive, got " +
+                           std::to_string(options.scale));
+  std::error_code ec;
+  if (!std::filesystem::is_regular_file(path, ec)) return NotFound("no such mesh file: " + path);
+
+  Assimp::Importer importer;
+  // Points and lines are split into meshes of their own (SortByPType) and skipped below.
+  importer.SetPropertyInteger(AI_CONFIG_PP_SBP_REMOVE,
+                              aiPrimitiveType_POINT | aiPrimitiveType_LINE);
+  const aiScene* scene =
+      importer.ReadFile(path, aiProcess_Triangulate | aiProcess_JoinIdenticalVertices |
+                                  aiProcess_PreTransformVertices | aiProcess_SortByPType);
+  if (!scene) return IoError("cannot read mesh " + path + ": " + importer.GetErrorString());
+
+  const std::string ext = LowerExtension(path);
+  const bool format_has_materials = ext != ".ply" && ext != ".stl";
+  // Colours and normals are kept only if every triangle mesh can supply them, so the merged
+  // arrays stay one per vertex.
+  bool any_color = false, all_normals = true, any_triangles = false;
+  for (unsigned int m = 0; m < scene->mNumMeshes; ++m) {
+    const aiMesh& mesh = *scene->mMeshes[m];
+    if (!(mesh.mPrimitiveTypes & aiPrimitiveType_TRIANGLE) || mesh.mNumFaces == 0) continue;
+    any_triangles = true;
+    aiColor4D c;
+    if (mesh.HasVertexColors(0) ||
+        MaterialDiffuse(*scene, mesh.mMaterialIndex, format_has_materials, &c))
+      any_color = true;
+    if (!mesh.HasNormals()) all_normals = false;
+  }
+  if (!any_triangles) return InvalidArgument("mesh file " + path + " holds no triangles");
+
+  Mesh out;
+  const float s = options.scale;
+  auto orient = [&](const aiVector3D& v, float k) -> Eigen::Vector3f {
+    if (options.up == UpAxis::kY) return {k * v.x, -k * v.z, k * v.y};
+    return {k * v.x, k * v.y, k * v.z};
+  };
+  for (unsigned int m = 0; m < scene->mNumMeshes; ++m) {
+    const aiMesh& mesh = *scene->mMeshes[m];
+    if (!(mesh.mPrimitiveTypes & aiPrimitiveType_TRIANGLE) || mesh.mNumFaces == 0) continue;
+    const size_t base = out.positions.size();
+    if (base + mesh.mNumVertices > size_t(UINT32_MAX))
+      return Unsupported("mesh " + path + " has more vertices than 32-bit indices can address");
+    for (unsigned int v = 0; v < mesh.mNumVertices; ++v)
+      out.positions.push_back(orient(mesh.mVertices[v], s));
+    if (all_normals) {
+      for (unsigned int v = 0; v < mesh.mNumVertices; ++v) {
+        Eigen::Vector3f n = orient(mesh.mNormals[v], 1.0f);
+        const float len = n.norm();
+        out.normals.push_back(len > 0.0f && std::isfinite(len) ? Eigen::Vector3f(n / len)
+                                                               : Eigen::Vector3f::UnitZ());
+      }
+    }
+    if (any_color) {
+      aiColor4D diffuse(0.6f, 0.6f, 0.6f, 1.0f);  // assimp's own default grey
+      const bool has_vertex_colors = mesh.HasVertexColors(0);
+      if (!has_vertex_colors)
+        MaterialDiffuse(*scene, mesh.mMaterialIndex, format_has_materials, &diffuse);
+      for (unsigned int v = 0; v < mesh.mNumVertices; ++v) {
+        const aiColor4D& c = has_vertex_colors ? mesh.mColors[0][v] : diffuse;
+        out.colors.push_back({ToByte(c.r), ToByte(c.g), ToByte(c.b)});
+      }
+    }
+    for (unsigned int f = 0; f < mesh.mNumFaces; ++f) {
+      const aiFace& face = mesh.mFaces[f];
+      if (face.mNumIndices != 3) continue;
+      out.triangles.push_back({uint32_t(base + face.mIndices[0]), uint32_t(base + face.mIndices[1]),
+                               uint32_t(base + face.mIndices[2])});
+    }
+  }
+  if (out.triangles.empty()) return InvalidArgument("mesh file " + path + " holds no triangles");
+  return out;
+}
+
+}  // namespace voxplan
