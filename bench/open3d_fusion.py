@@ -1,8 +1,9 @@
 #!/usr/bin/python3
 """Open3D reference timings for voxplan's fusion benchmarks.
 
-Reads a frame manifest (JSON: intrinsics, depth scale, parameters, frames with depth/colour
-paths and camera-to-world poses), decodes every image first, then times integration only with
+Reads the frame list that `voxplan fuse --frame-list F.json` writes (intrinsics, depth scale,
+parameters, and the integrated frames: depth/colour paths and row-major 4x4 camera-to-world
+poses), decodes every image first, then times integration only with
 Open3D's legacy ScalableTSDFVolume and its CPU VoxelBlockGrid on identical frames and
 parameters. Prints one JSON object. Run it with OMP_WAIT_POLICY=ACTIVE and OMP_NUM_THREADS set,
 or Open3D's OpenMP loops stall on small machines.
@@ -68,6 +69,8 @@ def main():
     paths = manifest.get("paths", ["legacy", "vbg"])
     legacy_frames, vbg_frames = [], []
     for f in manifest["frames"]:
+        if not f["color"]:
+            sys.exit("open3d_fusion.py: the frame list has frames without colour: " + f["depth"])
         T = np.array(f["T_W_C"], dtype=np.float64).reshape(4, 4)
         if "legacy" in paths:
             legacy_frames.append((o3d.io.read_image(f["depth"]), o3d.io.read_image(f["color"]), T))

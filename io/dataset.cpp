@@ -211,6 +211,7 @@ class ListDataset final : public Dataset {
     frame.timestamp = e.timestamp;
     frame.T_W_C = e.T_W_C;
     frame.depth_path = e.depth_path;
+    frame.color_path = e.color_path;
     auto depth = ReadDepthPng(e.depth_path, info_.depth_scale);
     if (!depth.ok()) return depth.status();
     frame.depth = std::move(depth).value();

@@ -44,6 +44,7 @@ struct Frame {
   ColorImage color;        // empty when the dataset has no colour
   std::optional<Pose3d> T_W_C;
   std::string depth_path;
+  std::string color_path;  // empty when the dataset has no colour
 };
 
 class Dataset {

@@ -1,0 +1,199 @@
+#include "apps/voxplan/cli_common.h"
+
+#include <sys/resource.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <iostream>
+#include <numeric>
+#include <sstream>
+
+#include "io/file_util.h"
+#include "io/mesh_io.h"
+
+namespace voxplan::cli {
+
+namespace fs = std::filesystem;
+
+int Fail(const std::string& message, int exit_code) {
+  std::cerr << "error: " << message << std::endl;
+  return exit_code;
+}
+
+void Warn(const std::string& message) { std::cerr << "warning: " << message << std::endl; }
+
+std::string MessageNaming(const Status& status, const std::string& path) {
+  if (status.message().find(path) != std::string::npos) return status.message();
+  return status.WithContext(path).message();
+}
+
+std::string CheckOutputFile(const std::string& path) {
+  if (path.empty()) return "empty output path";
+  const fs::path p(path);
+  std::error_code ec;
+  if (fs::is_directory(p, ec)) return "output path is a folder: " + path;
+  // The libraries write a temporary file beside the target, so the folder must exist now;
+  // refusing here keeps a long run from failing at the very end.
+  const fs::path parent = p.has_parent_path() ? p.parent_path() : fs::path(".");
+  if (!fs::is_directory(parent, ec)) {
+    return "output folder does not exist: " + parent.string() + " (for " + path + ")";
+  }
+  return {};
+}
+
+CLI::Validator OutputFileValidator() {
+  return CLI::Validator([](std::string& path) { return CheckOutputFile(path); }, "FILE");
+}
+
+CLI::Validator MeshOutputValidator() {
+  return CLI::Validator(
+      [](std::string& path) -> std::string {
+        if (!IsSupportedMeshExtension(path)) {
+          return "unsupported mesh extension (use .ply, .obj, .glb or .stl): " + path;
+        }
+        return CheckOutputFile(path);
+      },
+      "MESH");
+}
+
+namespace {
+
+CLI::Validator NumberCheck(bool allow_zero) {
+  return CLI::Validator(
+      [allow_zero](std::string& text) -> std::string {
+        double v = 0.0;
+        if (!CLI::detail::lexical_cast(text, v) || !std::isfinite(v))
+          return "not a number: " + text;
+        if (v < 0.0 || (!allow_zero && v == 0.0)) {
+          return std::string("must be ") + (allow_zero ? "zero or more" : "positive") + ", got " +
+                 text;
+        }
+        return {};
+      },
+      allow_zero ? "NONNEGATIVE" : "POSITIVE");
+}
+
+}  // namespace
+
+CLI::Validator Positive() { return NumberCheck(false); }
+CLI::Validator NonNegative() { return NumberCheck(true); }
+
+Result<PinholeCamera> ParseIntrinsics(const std::string& text) {
+  std::vector<float> values;
+  std::stringstream stream(text);
+  std::string item;
+  while (std::getline(stream, item, ',')) {
+    try {
+      size_t used = 0;
+      const float v = std::stof(item, &used);
+      if (used != item.size() || !std::isfinite(v)) throw std::invalid_argument(item);
+      values.push_back(v);
+    } catch (const std::exception&) {
+      return InvalidArgument("--intrinsics: not a number: '" + item + "'");
+    }
+  }
+  if (values.size() != 4) return InvalidArgument("--intrinsics wants fx,fy,cx,cy: " + text);
+  if (values[0] == 0.f || values[1] == 0.f) {
+    return InvalidArgument("--intrinsics: fx and fy must be non-zero: " + text);
+  }
+  PinholeCamera camera;
+  camera.fx = values[0];
+  camera.fy = values[1];
+  camera.cx = values[2];
+  camera.cy = values[3];
+  return camera;
+}
+
+TimingSummary Summarize(std::vector<double> values_ms) {
+  TimingSummary s;
+  if (values_ms.empty()) return s;
+  std::sort(values_ms.begin(), values_ms.end());
+  // Linear interpolation between closest ranks.
+  auto quantile = [&](double q) {
+    const double pos = q * double(values_ms.size() - 1);
+    const size_t lo = size_t(std::floor(pos));
+    const size_t hi = std::min(lo + 1, values_ms.size() - 1);
+    return values_ms[lo] + (pos - double(lo)) * (values_ms[hi] - values_ms[lo]);
+  };
+  s.median = quantile(0.5);
+  s.p90 = quantile(0.9);
+  s.total = std::accumulate(values_ms.begin(), values_ms.end(), 0.0);
+  s.mean = s.total / double(values_ms.size());
+  return s;
+}
+
+Progress::Progress(std::string label, size_t total)
+    : label_(std::move(label)), total_(total), tty_(::isatty(STDERR_FILENO) == 1) {}
+
+void Progress::Update(size_t done) {
+  if (total_ == 0) return;
+  const int percent = int(100 * done / total_);
+  if (tty_) {
+    if (percent == last_percent_) return;
+    last_percent_ = percent;
+    constexpr int kWidth = 30;
+    const int filled = percent * kWidth / 100;
+    std::fprintf(stderr, "\r%s [%s%s] %3d%% (%zu/%zu)", label_.c_str(),
+                 std::string(size_t(filled), '#').c_str(),
+                 std::string(size_t(kWidth - filled), '.').c_str(), percent, done, total_);
+    std::fflush(stderr);
+    bar_drawn_ = true;
+    return;
+  }
+  const int decile = percent / 10;
+  if (decile == last_decile_ || (decile == 0 && done < total_)) return;
+  last_decile_ = decile;
+  std::fprintf(stderr, "%s: %zu/%zu frames (%d%%)\n", label_.c_str(), done, total_, percent);
+}
+
+void Progress::ClearBar() {
+  if (!bar_drawn_) return;
+  std::fprintf(stderr, "\r\033[K");
+  bar_drawn_ = false;
+  last_percent_ = -1;  // redraw on the next update
+}
+
+void Progress::Warn(const std::string& message) {
+  ClearBar();
+  cli::Warn(message);
+}
+
+void Progress::Finish() {
+  if (tty_ && bar_drawn_) {
+    std::fprintf(stderr, "\n");
+    bar_drawn_ = false;
+  }
+}
+
+double PeakRssMb() {
+  rusage usage{};
+  if (getrusage(RUSAGE_SELF, &usage) != 0) return 0.0;
+  return RoundTo(double(usage.ru_maxrss) / 1024.0, 1);  // ru_maxrss is KiB on Linux
+}
+
+double RoundTo(double value, int decimals) {
+  const double scale = std::pow(10.0, decimals);
+  return std::round(value * scale) / scale;
+}
+
+double FloatValue(float value) {
+  char text[32];
+  std::snprintf(text, sizeof(text), "%.7g", double(value));
+  return std::strtod(text, nullptr);
+}
+
+double Mib(size_t bytes) { return RoundTo(double(bytes) / (1024.0 * 1024.0), 3); }
+
+Status WriteJsonFile(const nlohmann::json& json, const std::string& path) {
+  const std::string text = json.dump(2) + "\n";
+  return WriteAtomically(
+      path, [&](const std::string& tmp_path) { return WriteStringToFile(tmp_path, text); });
+}
+
+void PrintJsonLine(const nlohmann::json& json) { std::cout << json.dump() << std::endl; }
+
+}  // namespace voxplan::cli

@@ -1,0 +1,99 @@
+#pragma once
+// Helpers every voxplan subcommand shares: exit codes, error printing, output-path checks,
+// timing summaries, progress reporting and the one-line JSON result.
+#include <CLI/CLI.hpp>
+#include <chrono>
+#include <cstddef>
+#include <functional>
+#include <nlohmann/json.hpp>
+#include <string>
+#include <vector>
+
+#include "core/camera.h"
+#include "core/status.h"
+
+namespace voxplan::cli {
+
+inline constexpr int kExitOk = 0;
+inline constexpr int kExitFailure = 1;  // I/O, data or library failures
+inline constexpr int kExitUsage = 2;    // bad arguments, refused before any work
+
+// A parsed subcommand and the function that runs it once CLI11 is done.
+struct Command {
+  CLI::App* app = nullptr;
+  std::function<int()> run;
+};
+
+Command AddFuseCommand(CLI::App& app);
+Command AddMeshCommand(CLI::App& app);
+Command AddInfoCommand(CLI::App& app);
+Command AddEvalCommand(CLI::App& app);
+Command AddDemoCommand(CLI::App& app);
+
+// Prints `error: <message>` on stderr and returns exit_code, so callers can `return Fail(...)`.
+int Fail(const std::string& message, int exit_code = kExitFailure);
+void Warn(const std::string& message);
+// The library's message, with `path` in front unless it already names it.
+std::string MessageNaming(const Status& status, const std::string& path);
+
+// Empty when `path` can be written: its folder exists and it is not itself a folder.
+std::string CheckOutputFile(const std::string& path);
+// CLI11 validators built on CheckOutputFile; the mesh one also checks the extension.
+CLI::Validator OutputFileValidator();
+CLI::Validator MeshOutputValidator();
+// Numeric checks with short messages (CLI11 2.1's own print the whole double range).
+CLI::Validator Positive();
+CLI::Validator NonNegative();
+
+// "fx,fy,cx,cy" -> camera with width/height 0 (the dataset's images give the size).
+Result<PinholeCamera> ParseIntrinsics(const std::string& text);
+
+struct TimingSummary {
+  double median = 0.0, p90 = 0.0, mean = 0.0, total = 0.0;
+};
+TimingSummary Summarize(std::vector<double> values_ms);
+
+class Stopwatch {
+ public:
+  Stopwatch() : start_(std::chrono::steady_clock::now()) {}
+  double ElapsedMs() const {
+    return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start_)
+        .count();
+  }
+
+ private:
+  std::chrono::steady_clock::time_point start_;
+};
+
+// Progress on stderr: a redrawn bar on a terminal, else a plain line every ~10% so logs
+// stay short.
+class Progress {
+ public:
+  Progress(std::string label, size_t total);
+  void Update(size_t done);
+  // Prints a warning without tearing the bar.
+  void Warn(const std::string& message);
+  void Finish();
+
+ private:
+  void ClearBar();
+  std::string label_;
+  size_t total_;
+  bool tty_;
+  bool bar_drawn_ = false;
+  int last_decile_ = -1;
+  int last_percent_ = -1;
+};
+
+double PeakRssMb();  // MiB, from getrusage
+double RoundTo(double value, int decimals);
+// A float as the double with the same shortest decimal form (0.02f -> 0.02, not 0.0199999...).
+double FloatValue(float value);
+double Mib(size_t bytes);
+
+// Writes JSON (pretty) through WriteAtomically; the error names the file.
+Status WriteJsonFile(const nlohmann::json& json, const std::string& path);
+// The machine-readable result: one JSON object as the last line of stdout.
+void PrintJsonLine(const nlohmann::json& json);
+
+}  // namespace voxplan::cli

@@ -1,0 +1,328 @@
+// voxplan fuse: dataset -> TSDF volume -> mesh / map / stats.
+#include <algorithm>
+#include <filesystem>
+#include <iostream>
+#include <map>
+#include <memory>
+#include <sstream>
+
+#include "apps/voxplan/cli_common.h"
+#include "core/parallel.h"
+#include "core/volume.h"
+#include "fusion/integrate.h"
+#include "fusion/mesh_extract.h"
+#include "io/dataset.h"
+#include "io/map_io.h"
+#include "io/mesh_io.h"
+
+namespace voxplan::cli {
+
+namespace {
+
+namespace fs = std::filesystem;
+
+const std::map<std::string, Weighting> kWeightings = {{"constant", Weighting::kConstant},
+                                                      {"depth", Weighting::kDepthDependent}};
+const std::map<std::string, Kernel> kKernels = {
+    {"auto", Kernel::kAuto}, {"scalar", Kernel::kScalar}, {"simd", Kernel::kSimd}};
+
+struct FuseOptions {
+  std::string dataset;
+  std::string format = "auto";
+  double voxel_size_m = 0.01;
+  double trunc_m = 0.04;
+  double min_depth_m = 0.1;
+  double max_depth_m = 3.0;
+  // Signed so CLI11 refuses negative values instead of wrapping them.
+  int64_t frames = 0;  // 0: all
+  int64_t start = 0;
+  int64_t stride = 1;
+  int threads = 0;
+  std::string intrinsics;
+  double depth_scale = 0.0;
+  std::string weighting = "constant";
+  std::string kernel = "auto";
+  double max_weight = 64.0;
+  double mesh_min_weight = 0.5;
+  std::string mesh_path, map_path, stats_path, frame_list_path;
+};
+
+// Beyond this many, per-frame skip warnings collapse into one count at the end.
+constexpr int kMaxSkipWarnings = 5;
+
+bool AllZero(const DepthImage& depth) {
+  return std::none_of(depth.data.begin(), depth.data.end(), [](float z) { return z > 0.f; });
+}
+
+nlohmann::json OrNull(const std::string& path) {
+  return path.empty() ? nlohmann::json(nullptr) : nlohmann::json(path);
+}
+
+int RunFuse(const FuseOptions& o) {
+  // Everything the arguments alone can refuse is refused before the dataset is read.
+  if (o.trunc_m < o.voxel_size_m) {
+    std::ostringstream message;
+    message << "--trunc (" << o.trunc_m << ") must be at least --voxel-size (" << o.voxel_size_m
+            << ")";
+    return Fail(message.str(), kExitUsage);
+  }
+  if (o.max_depth_m <= o.min_depth_m) {
+    return Fail("--max-depth must be greater than --min-depth", kExitUsage);
+  }
+  DatasetOptions dataset_options;
+  Result<DatasetFormat> format = ParseDatasetFormat(o.format);
+  if (!format.ok()) return Fail(format.status().message(), kExitUsage);
+  dataset_options.format = *format;
+  if (!o.intrinsics.empty()) {
+    Result<PinholeCamera> camera = ParseIntrinsics(o.intrinsics);
+    if (!camera.ok()) return Fail(camera.status().message(), kExitUsage);
+    dataset_options.intrinsics = *camera;
+  }
+  if (o.depth_scale > 0.0) dataset_options.depth_scale = o.depth_scale;
+
+  std::error_code ec;
+  if (!fs::exists(o.dataset, ec)) return Fail("dataset folder not found: " + o.dataset);
+  if (!fs::is_directory(o.dataset, ec)) return Fail("dataset is not a folder: " + o.dataset);
+
+  ThreadLimit thread_limit(o.threads);
+  Result<std::unique_ptr<Dataset>> opened = OpenDataset(o.dataset, dataset_options);
+  if (!opened.ok()) return Fail(MessageNaming(opened.status(), o.dataset));
+  const Dataset& dataset = **opened;
+  const DatasetInfo& info = dataset.info();
+  for (const std::string& w : info.warnings) Warn(w);
+
+  std::vector<size_t> indices;
+  for (size_t i = size_t(o.start); i < info.num_frames; i += size_t(o.stride)) {
+    if (o.frames > 0 && indices.size() == size_t(o.frames)) break;
+    indices.push_back(i);
+  }
+  if (indices.empty()) {
+    return Fail("no frames selected: the dataset has " + std::to_string(info.num_frames) +
+                    " frames and --start is " + std::to_string(o.start),
+                kExitUsage);
+  }
+
+  IntegrateParams params;
+  params.min_depth_m = float(o.min_depth_m);
+  params.max_depth_m = float(o.max_depth_m);
+  params.max_weight = float(o.max_weight);
+  params.weighting = kWeightings.at(o.weighting);
+  params.kernel = kKernels.at(o.kernel);
+  TsdfVolume volume(VolumeParams{float(o.voxel_size_m), float(o.trunc_m)});
+
+  std::cerr << "fuse: " << info.root << " (" << DatasetFormatName(info.format) << "), "
+            << indices.size() << " of " << info.num_frames << " frames, voxel " << o.voxel_size_m
+            << " m, trunc " << o.trunc_m << " m, " << MaxThreads() << " threads, kernel "
+            << KernelName(ResolveKernel(params.kernel)) << std::endl;
+
+  std::vector<double> load_ms, integrate_ms, frame_ms;
+  nlohmann::json frame_list = nlohmann::json::array();
+  size_t skipped_no_pose = 0, skipped_empty = 0;
+  Progress progress("fuse", indices.size());
+  const Stopwatch loop_clock;
+  for (size_t k = 0; k < indices.size(); ++k) {
+    const size_t i = indices[k];
+    const Stopwatch load_clock;
+    Result<Frame> frame = dataset.Load(i);
+    const double load = load_clock.ElapsedMs();
+    if (!frame.ok()) {
+      progress.Finish();
+      return Fail("frame " + std::to_string(i) + ": " + frame.status().message());
+    }
+    if (!frame->T_W_C) {
+      if (++skipped_no_pose <= kMaxSkipWarnings) {
+        progress.Warn("frame " + std::to_string(i) + " (" + frame->depth_path +
+                      ") has no pose; skipped");
+      }
+    } else if (AllZero(frame->depth)) {
+      if (++skipped_empty <= kMaxSkipWarnings) {
+        progress.Warn("frame " + std::to_string(i) + " (" + frame->depth_path +
+                      ") has no valid depth; skipped");
+      }
+    } else {
+      const Stopwatch integrate_clock;
+      Result<IntegrateStats> stats = IntegrateFrame(frame->depth, frame->color, info.camera,
+                                                    frame->T_W_C->cast<float>(), params, volume);
+      const double integrate = integrate_clock.ElapsedMs();
+      if (!stats.ok()) {
+        progress.Finish();
+        return Fail(MessageNaming(stats.status(), frame->depth_path));
+      }
+      load_ms.push_back(load);
+      integrate_ms.push_back(integrate);
+      frame_ms.push_back(load + integrate);
+      if (!o.frame_list_path.empty()) {
+        const Eigen::Matrix<double, 4, 4, Eigen::RowMajor> T = frame->T_W_C->matrix();
+        frame_list.push_back({{"depth", frame->depth_path},
+                              {"color", frame->color_path},
+                              {"T_W_C", std::vector<double>(T.data(), T.data() + 16)}});
+      }
+    }
+    progress.Update(k + 1);
+  }
+  progress.Finish();
+  const double loop_s = loop_clock.ElapsedMs() / 1000.0;
+  if (skipped_no_pose > kMaxSkipWarnings) {
+    Warn(std::to_string(skipped_no_pose) + " frames in all had no pose and were skipped");
+  }
+  if (skipped_empty > kMaxSkipWarnings) {
+    Warn(std::to_string(skipped_empty) + " frames in all had no valid depth and were skipped");
+  }
+  if (frame_ms.empty()) {
+    return Fail("no frame was integrated (" + std::to_string(indices.size()) +
+                " selected, all skipped): " + o.dataset);
+  }
+
+  Mesh mesh;
+  double mesh_ms = 0.0;
+  if (!o.mesh_path.empty()) {
+    const Stopwatch mesh_clock;
+    MeshParams mesh_params;
+    mesh_params.min_weight = float(o.mesh_min_weight);
+    mesh = ExtractMesh(volume, mesh_params);
+    mesh_ms = mesh_clock.ElapsedMs();
+    if (Status s = WriteMesh(mesh, o.mesh_path); !s.ok()) {
+      return Fail(MessageNaming(s, o.mesh_path));
+    }
+  }
+  if (!o.map_path.empty()) {
+    if (Status s = SaveMap(volume, o.map_path); !s.ok()) return Fail(MessageNaming(s, o.map_path));
+  }
+  if (!o.frame_list_path.empty()) {
+    // Exactly the frames integrated, with the parameters, for reference runs of other
+    // pipelines (bench/open3d_fusion.py) on identical input.
+    nlohmann::json list = {{"width", info.camera.width},     {"height", info.camera.height},
+                           {"fx", FloatValue(info.camera.fx)}, {"fy", FloatValue(info.camera.fy)},
+                           {"cx", FloatValue(info.camera.cx)}, {"cy", FloatValue(info.camera.cy)},
+                           {"depth_scale", info.depth_scale},  {"voxel_size_m", o.voxel_size_m},
+                           {"trunc_m", o.trunc_m},             {"min_depth_m", o.min_depth_m},
+                           {"max_depth_m", o.max_depth_m},     {"frames", frame_list}};
+    if (Status s = WriteJsonFile(list, o.frame_list_path); !s.ok())
+      return Fail(MessageNaming(s, o.frame_list_path));
+  }
+
+  const TimingSummary load_t = Summarize(load_ms), integrate_t = Summarize(integrate_ms),
+                      frame_t = Summarize(frame_ms);
+  const size_t integrated = frame_ms.size();
+  nlohmann::json j;
+  j["command"] = "fuse";
+  j["dataset"] = o.dataset;
+  j["format"] = DatasetFormatName(info.format);
+  j["frames"] = integrated;
+  j["frames_selected"] = indices.size();
+  j["frames_skipped"] = skipped_no_pose + skipped_empty;
+  j["frames_skipped_no_pose"] = skipped_no_pose;
+  j["frames_skipped_no_depth"] = skipped_empty;
+  j["voxel_size_m"] = o.voxel_size_m;
+  j["trunc_m"] = o.trunc_m;
+  j["min_depth_m"] = o.min_depth_m;
+  j["max_depth_m"] = o.max_depth_m;
+  j["max_weight"] = o.max_weight;
+  j["weighting"] = o.weighting;
+  j["threads"] = MaxThreads();
+  j["kernel"] = KernelName(ResolveKernel(params.kernel));
+  j["camera"] = {{"width", info.camera.width},       {"height", info.camera.height},
+                 {"fx", FloatValue(info.camera.fx)}, {"fy", FloatValue(info.camera.fy)},
+                 {"cx", FloatValue(info.camera.cx)}, {"cy", FloatValue(info.camera.cy)}};
+  j["depth_scale"] = info.depth_scale;
+  j["integrate_ms_median"] = RoundTo(integrate_t.median, 3);
+  j["integrate_ms_p90"] = RoundTo(integrate_t.p90, 3);
+  j["integrate_ms_mean"] = RoundTo(integrate_t.mean, 3);
+  j["load_ms_median"] = RoundTo(load_t.median, 3);
+  j["load_ms_p90"] = RoundTo(load_t.p90, 3);
+  j["frame_ms_median"] = RoundTo(frame_t.median, 3);
+  j["frame_ms_p90"] = RoundTo(frame_t.p90, 3);
+  j["loop_s"] = RoundTo(loop_s, 3);
+  // Throughput of the whole frame loop (decode + integrate + skipped frames).
+  j["fps"] = RoundTo(loop_s > 0 ? double(integrated) / loop_s : 0.0, 2);
+  j["blocks"] = volume.num_blocks();
+  j["voxels"] = volume.num_voxels();
+  j["bytes_per_voxel"] = TsdfVolume::BytesPerVoxel();
+  j["map_mb"] = Mib(volume.MemoryBytes());
+  j["mesh_vertices"] = mesh.num_vertices();
+  j["mesh_triangles"] = mesh.num_triangles();
+  j["mesh_ms"] = RoundTo(mesh_ms, 3);
+  j["mesh"] = OrNull(o.mesh_path);
+  j["map"] = OrNull(o.map_path);
+  j["stats"] = OrNull(o.stats_path);
+  j["peak_rss_mb"] = PeakRssMb();
+  if (!o.stats_path.empty()) {
+    if (Status s = WriteJsonFile(j, o.stats_path); !s.ok()) {
+      return Fail(MessageNaming(s, o.stats_path));
+    }
+  }
+
+  std::cerr << "fused " << integrated << " frames (" << j["frames_skipped"] << " skipped) in "
+            << j["loop_s"] << " s: integrate median " << j["integrate_ms_median"]
+            << " ms, load median " << j["load_ms_median"] << " ms, " << j["fps"] << " fps\n"
+            << "map: " << volume.num_blocks() << " blocks, " << j["map_mb"] << " MiB, peak RSS "
+            << j["peak_rss_mb"] << " MiB\n";
+  if (!o.mesh_path.empty()) {
+    std::cerr << "mesh: " << o.mesh_path << " (" << mesh.num_vertices() << " vertices, "
+              << mesh.num_triangles() << " triangles, " << j["mesh_ms"] << " ms)\n";
+  }
+  if (!o.map_path.empty()) std::cerr << "map file: " << o.map_path << "\n";
+  if (!o.stats_path.empty()) std::cerr << "stats: " << o.stats_path << "\n";
+  PrintJsonLine(j);
+  return kExitOk;
+}
+
+}  // namespace
+
+Command AddFuseCommand(CLI::App& app) {
+  auto o = std::make_shared<FuseOptions>();
+  CLI::App* sub = app.add_subcommand("fuse", "Integrate an RGB-D dataset into a TSDF map");
+  sub->add_option("dataset", o->dataset, "Dataset folder")->required();
+  sub->add_option("--format", o->format, "Dataset format")
+      ->check(CLI::IsMember({"auto", "tum", "icl", "redwood", "7scenes", "3dmatch", "replica"}))
+      ->capture_default_str();
+  sub->add_option("--voxel-size", o->voxel_size_m, "Voxel size in metres")
+      ->check(Positive())
+      ->capture_default_str();
+  sub->add_option("--trunc", o->trunc_m, "Truncation distance in metres")
+      ->check(Positive())
+      ->capture_default_str();
+  sub->add_option("--min-depth", o->min_depth_m, "Ignore depth below this (m)")
+      ->check(NonNegative())
+      ->capture_default_str();
+  sub->add_option("--max-depth", o->max_depth_m, "Ignore depth beyond this (m)")
+      ->check(Positive())
+      ->capture_default_str();
+  sub->add_option("--frames", o->frames, "Frames to process (0: all)")
+      ->check(NonNegative())
+      ->capture_default_str();
+  sub->add_option("--start", o->start, "First frame (0-based)")
+      ->check(NonNegative())
+      ->capture_default_str();
+  sub->add_option("--stride", o->stride, "Use every K-th frame")
+      ->check(CLI::Range(int64_t(1), int64_t(1) << 30))
+      ->capture_default_str();
+  sub->add_option("--threads", o->threads, "Worker threads (0: all hardware threads)")
+      ->check(NonNegative())
+      ->capture_default_str();
+  sub->add_option("--intrinsics", o->intrinsics, "Override intrinsics: fx,fy,cx,cy");
+  sub->add_option("--depth-scale", o->depth_scale, "Override depth units per metre")
+      ->check(Positive());
+  sub->add_option("--weighting", o->weighting, "Observation weight")
+      ->check(CLI::IsMember({"constant", "depth"}))
+      ->capture_default_str();
+  sub->add_option("--kernel", o->kernel, "Integration kernel")
+      ->check(CLI::IsMember({"auto", "scalar", "simd"}))
+      ->capture_default_str();
+  sub->add_option("--max-weight", o->max_weight, "Weight cap per voxel")
+      ->check(Positive())
+      ->capture_default_str();
+  sub->add_option("--mesh-min-weight", o->mesh_min_weight, "Meshing: ignore voxels below this")
+      ->check(NonNegative())
+      ->capture_default_str();
+  sub->add_option("--mesh", o->mesh_path, "Write the mesh (.ply .obj .glb .stl)")
+      ->check(MeshOutputValidator());
+  sub->add_option("--map", o->map_path, "Write the map (.vpmap)")->check(OutputFileValidator());
+  sub->add_option("--stats", o->stats_path, "Write the stats JSON")->check(OutputFileValidator());
+  sub->add_option("--frame-list", o->frame_list_path,
+                  "Write the integrated frames (paths, poses, intrinsics) as JSON")
+      ->check(OutputFileValidator());
+  return {sub, [o] { return RunFuse(*o); }};
+}
+
+}  // namespace voxplan::cli

@@ -1,0 +1,128 @@
+// voxplan info: what a dataset folder or a map file holds, as the readers see it.
+#include <cstdio>
+#include <filesystem>
+#include <iostream>
+#include <memory>
+
+#include "apps/voxplan/cli_common.h"
+#include "core/block.h"
+#include "io/dataset.h"
+#include "io/map_io.h"
+
+namespace voxplan::cli {
+
+namespace {
+
+namespace fs = std::filesystem;
+
+struct InfoOptions {
+  std::string path;
+  std::string format = "auto";
+};
+
+int DatasetInfoCommand(const InfoOptions& o) {
+  DatasetOptions options;
+  Result<DatasetFormat> format = ParseDatasetFormat(o.format);
+  if (!format.ok()) return Fail(format.status().message(), kExitUsage);
+  options.format = *format;
+  Result<std::unique_ptr<Dataset>> dataset = OpenDataset(o.path, options);
+  if (!dataset.ok()) return Fail(MessageNaming(dataset.status(), o.path));
+  const DatasetInfo& info = (*dataset)->info();
+  const PinholeCamera& c = info.camera;
+
+  std::printf("dataset     %s\n", info.root.c_str());
+  std::printf("format      %s\n", DatasetFormatName(info.format));
+  std::printf("frames      %zu\n", info.num_frames);
+  std::printf("image       %d x %d\n", c.width, c.height);
+  std::printf("intrinsics  fx %g  fy %g  cx %g  cy %g  (%s)\n", c.fx, c.fy, c.cx, c.cy,
+              info.intrinsics_source.c_str());
+  std::printf("depth scale %g units per metre\n", info.depth_scale);
+  std::printf("poses       %s\n", info.pose_source.c_str());
+  std::printf("colour      %s\n", info.has_color ? "yes" : "no");
+  std::printf("warnings    %zu\n", info.warnings.size());
+  for (const std::string& w : info.warnings) std::printf("  %s\n", w.c_str());
+  std::fflush(stdout);
+
+  nlohmann::json j;
+  j["command"] = "info";
+  j["kind"] = "dataset";
+  j["path"] = o.path;
+  j["root"] = info.root;
+  j["format"] = DatasetFormatName(info.format);
+  j["frames"] = info.num_frames;
+  j["camera"] = {{"width", c.width},       {"height", c.height},     {"fx", FloatValue(c.fx)},
+                 {"fy", FloatValue(c.fy)}, {"cx", FloatValue(c.cx)}, {"cy", FloatValue(c.cy)}};
+  j["intrinsics_source"] = info.intrinsics_source;
+  j["depth_scale"] = info.depth_scale;
+  j["pose_source"] = info.pose_source;
+  j["has_color"] = info.has_color;
+  j["warnings"] = info.warnings;
+  PrintJsonLine(j);
+  return kExitOk;
+}
+
+int MapInfoCommand(const InfoOptions& o) {
+  Result<MapHeader> header = ReadMapHeader(o.path);
+  if (!header.ok()) return Fail(MessageNaming(header.status(), o.path));
+  Result<TsdfVolume> volume = LoadMap(o.path);
+  if (!volume.ok()) return Fail(MessageNaming(volume.status(), o.path));
+
+  size_t observed = 0;
+  volume->ForEachBlock([&](BlockIndex, const TsdfBlock& block) {
+    for (int v = 0; v < kBlockVoxels; ++v) observed += block.weight[v] > 0 ? 1 : 0;
+  });
+  std::error_code ec;
+  const auto file_bytes = fs::file_size(o.path, ec);
+  const double observed_percent =
+      volume->num_voxels() > 0 ? 100.0 * double(observed) / double(volume->num_voxels()) : 0.0;
+
+  std::printf("map         %s\n", o.path.c_str());
+  std::printf("version     %u\n", header->version);
+  std::printf("voxel size  %g m\n", header->params.voxel_size_m);
+  std::printf("truncation  %g m\n", header->params.trunc_m);
+  std::printf("blocks      %llu (%zu voxels, %zu observed, %.1f%%)\n",
+              (unsigned long long)header->num_blocks, volume->num_voxels(), observed,
+              observed_percent);
+  std::printf("memory      %.3f MiB (%.1f bytes per voxel)\n", Mib(volume->MemoryBytes()),
+              TsdfVolume::BytesPerVoxel());
+  std::printf("file        %.3f MiB\n", Mib(ec ? 0 : size_t(file_bytes)));
+  std::fflush(stdout);
+
+  nlohmann::json j;
+  j["command"] = "info";
+  j["kind"] = "map";
+  j["path"] = o.path;
+  j["version"] = header->version;
+  j["voxel_size_m"] = FloatValue(header->params.voxel_size_m);
+  j["trunc_m"] = FloatValue(header->params.trunc_m);
+  j["blocks"] = header->num_blocks;
+  j["voxels"] = volume->num_voxels();
+  j["observed_voxels"] = observed;
+  j["bytes_per_voxel"] = TsdfVolume::BytesPerVoxel();
+  j["memory_bytes"] = volume->MemoryBytes();
+  j["map_mb"] = Mib(volume->MemoryBytes());
+  j["file_bytes"] = ec ? 0 : size_t(file_bytes);
+  PrintJsonLine(j);
+  return kExitOk;
+}
+
+int RunInfo(const InfoOptions& o) {
+  std::error_code ec;
+  if (fs::is_directory(o.path, ec)) return DatasetInfoCommand(o);
+  if (fs::is_regular_file(o.path, ec)) return MapInfoCommand(o);
+  return Fail("not found (want a dataset folder or a .vpmap file): " + o.path);
+}
+
+}  // namespace
+
+Command AddInfoCommand(CLI::App& app) {
+  auto o = std::make_shared<InfoOptions>();
+  CLI::App* sub = app.add_subcommand("info", "Describe a dataset folder or a map file");
+  sub->add_option("path", o->path, "Dataset folder or .vpmap file")->required();
+  sub->add_option("--format", o->format, "Dataset format (folders only)")
+      ->check(CLI::IsMember({"auto", "tum", "icl", "redwood", "7scenes", "3dmatch", "replica"}))
+      ->capture_default_str();
+  return {sub, [o] { return RunInfo(*o); }};
+}
+
+}  // namespace voxplan::cli

@@ -1,0 +1,45 @@
+// voxplan: one CLI, one subcommand per task. Each cmd_*.cpp parses its flags, calls the
+// libraries and prints; nothing here knows how fusion or I/O work.
+#include <CLI/CLI.hpp>
+#include <exception>
+#include <iostream>
+#include <vector>
+
+#include "apps/voxplan/cli_common.h"
+
+int main(int argc, char** argv) {
+  using namespace voxplan::cli;
+  CLI::App app{"voxplan: CPU voxel-hashing TSDF mapping (fuse RGB-D, mesh, evaluate, demo)",
+               "voxplan"};
+  app.set_version_flag("--version", "voxplan 0.1.0");
+  app.require_subcommand(1);
+  // Usage errors read like every other error; CLI11's own help hint follows.
+  app.failure_message([](const CLI::App* a, const CLI::Error& e) {
+    return "error: " + std::string(e.what()) + "\nRun with --help for more information.\n";
+  });
+
+  std::vector<Command> commands = {AddFuseCommand(app), AddMeshCommand(app), AddInfoCommand(app),
+                                   AddEvalCommand(app), AddDemoCommand(app)};
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::CallForHelp& e) {
+    return app.exit(e);
+  } catch (const CLI::CallForAllHelp& e) {
+    return app.exit(e);
+  } catch (const CLI::CallForVersion& e) {
+    return app.exit(e);
+  } catch (const CLI::ParseError& e) {
+    app.exit(e);  // prints through failure_message
+    return kExitUsage;
+  }
+
+  try {
+    for (const Command& command : commands) {
+      if (command.app->parsed()) return command.run();
+    }
+  } catch (const std::exception& e) {
+    // Libraries only throw on invalid construction; arguments are checked before that.
+    return Fail(e.what());
+  }
+  return Fail("no command given", kExitUsage);
+}
