@@ -3,12 +3,12 @@
 #include <cstdio>
 #include <cstdlib>
 
-#define VOXPLAN_ASSERT(cond)                                                             \
-  do {                                                                                   \
-    if (!(cond)) {                                                                       \
+#define VOXPLAN_ASSERT(cond)                                                            \
+  do {                                                                                  \
+    if (!(cond)) {                                                                      \
       std::fprintf(stderr, "%s:%d: assertion failed: %s\n", __FILE__, __LINE__, #cond); \
-      std::abort();                                                                      \
-    }                                                                                    \
+      std::abort();                                                                     \
+    }                                                                                   \
   } while (0)
 
 #ifdef NDEBUG

@@ -12,8 +12,8 @@ Status ValidatePoseMatrix(const Eigen::Matrix4d& m) {
   const Eigen::Matrix3d r = m.topLeftCorner<3, 3>();
   const double ortho_err = (r.transpose() * r - Eigen::Matrix3d::Identity()).cwiseAbs().maxCoeff();
   if (ortho_err > 1e-3 || r.determinant() < 0.0)
-    return InvalidArgument("pose rotation is not orthonormal (|R^T R - I| = " +
-                           std::to_string(ortho_err) + ")");
+    return InvalidArgument(
+        "pose rotation is not orthonormal (|R^T R - I| = " + std::to_string(ortho_err) + ")");
   return Status::Ok();
 }
 

@@ -48,8 +48,8 @@ std::optional<VoxelValue> Interpolate(const TsdfVolume& volume, const Eigen::Vec
     const int i = LinearIndex(LocalOf(g));
     const float w = DecodeWeight(cached->weight[i]);
     if (w < min_weight || w == 0.f) return std::nullopt;
-    const float t = (dx ? f.x() : 1.f - f.x()) * (dy ? f.y() : 1.f - f.y()) *
-                    (dz ? f.z() : 1.f - f.z());
+    const float t =
+        (dx ? f.x() : 1.f - f.x()) * (dy ? f.y() : 1.f - f.y()) * (dz ? f.z() : 1.f - f.z());
     out.tsdf_m += t * DecodeTsdf(cached->tsdf[i]);
     out.weight += t * w;
     out.rgb += t * Eigen::Vector3f(cached->r[i], cached->g[i], cached->b[i]);

@@ -8,7 +8,15 @@
 
 namespace voxplan {
 
-enum class StatusCode { kOk = 0, kInvalidArgument, kNotFound, kIoError, kCorruptData, kUnsupported, kInternal };
+enum class StatusCode {
+  kOk = 0,
+  kInvalidArgument,
+  kNotFound,
+  kIoError,
+  kCorruptData,
+  kUnsupported,
+  kInternal
+};
 
 class [[nodiscard]] Status {
  public:
@@ -29,7 +37,9 @@ class [[nodiscard]] Status {
   std::string message_;
 };
 
-inline Status InvalidArgument(std::string m) { return {StatusCode::kInvalidArgument, std::move(m)}; }
+inline Status InvalidArgument(std::string m) {
+  return {StatusCode::kInvalidArgument, std::move(m)};
+}
 inline Status NotFound(std::string m) { return {StatusCode::kNotFound, std::move(m)}; }
 inline Status IoError(std::string m) { return {StatusCode::kIoError, std::move(m)}; }
 inline Status CorruptData(std::string m) { return {StatusCode::kCorruptData, std::move(m)}; }
@@ -43,9 +53,18 @@ class [[nodiscard]] Result {
 
   bool ok() const { return value_.has_value(); }
   const Status& status() const { return status_; }
-  T& value() & { assert(ok()); return *value_; }
-  const T& value() const& { assert(ok()); return *value_; }
-  T&& value() && { assert(ok()); return std::move(*value_); }
+  T& value() & {
+    assert(ok());
+    return *value_;
+  }
+  const T& value() const& {
+    assert(ok());
+    return *value_;
+  }
+  T&& value() && {
+    assert(ok());
+    return std::move(*value_);
+  }
   T* operator->() { return &value(); }
   const T* operator->() const { return &value(); }
   T& operator*() & { return value(); }
@@ -59,8 +78,8 @@ class [[nodiscard]] Result {
 }  // namespace voxplan
 
 // Returns early from a Status- or Result-returning function when `expr` failed.
-#define VOXPLAN_RETURN_IF_ERROR(expr)            \
-  do {                                           \
-    ::voxplan::Status _vp_status = (expr);       \
-    if (!_vp_status.ok()) return _vp_status;     \
+#define VOXPLAN_RETURN_IF_ERROR(expr)        \
+  do {                                       \
+    ::voxplan::Status _vp_status = (expr);   \
+    if (!_vp_status.ok()) return _vp_status; \
   } while (0)

@@ -40,12 +40,13 @@ void ForEachBlockOnSegment(const Eigen::Vector3f& a, const Eigen::Vector3f& b, f
     }
   }
   // Bounded: a segment crosses at most |dx|+|dy|+|dz|+1 cells; guards against float drift.
-  const int max_steps = std::abs(last[0] - cell[0]) + std::abs(last[1] - cell[1]) +
-                        std::abs(last[2] - cell[2]) + 1;
+  const int max_steps =
+      std::abs(last[0] - cell[0]) + std::abs(last[1] - cell[1]) + std::abs(last[2] - cell[2]) + 1;
   for (int i = 0; i < max_steps; ++i) {
     visit(BlockIndex{cell[0], cell[1], cell[2]});
     if (cell[0] == last[0] && cell[1] == last[1] && cell[2] == last[2]) break;
-    const int k = (t_max[0] < t_max[1]) ? (t_max[0] < t_max[2] ? 0 : 2) : (t_max[1] < t_max[2] ? 1 : 2);
+    const int k =
+        (t_max[0] < t_max[1]) ? (t_max[0] < t_max[2] ? 0 : 2) : (t_max[1] < t_max[2] ? 1 : 2);
     cell[k] += step[k];
     t_max[k] += t_delta[k];
   }
@@ -54,7 +55,8 @@ void ForEachBlockOnSegment(const Eigen::Vector3f& a, const Eigen::Vector3f& b, f
 Status ValidateParams(const IntegrateParams& p) {
   if (!(p.min_depth_m >= 0.f && p.max_depth_m > p.min_depth_m && std::isfinite(p.max_depth_m)))
     return InvalidArgument("depth range must satisfy 0 <= min < max, got [" +
-                           std::to_string(p.min_depth_m) + ", " + std::to_string(p.max_depth_m) + "]");
+                           std::to_string(p.min_depth_m) + ", " + std::to_string(p.max_depth_m) +
+                           "]");
   if (!(p.max_weight > 0.f && p.max_weight <= kMaxWeight))
     return InvalidArgument("max weight must be in (0, " + std::to_string(kMaxWeight) + "], got " +
                            std::to_string(p.max_weight));
@@ -79,9 +81,12 @@ Kernel ResolveKernel(Kernel requested) {
 
 const char* KernelName(Kernel kernel) {
   switch (kernel) {
-    case Kernel::kAuto: return "auto";
-    case Kernel::kScalar: return "scalar";
-    case Kernel::kSimd: return "avx2";
+    case Kernel::kAuto:
+      return "auto";
+    case Kernel::kScalar:
+      return "scalar";
+    case Kernel::kSimd:
+      return "avx2";
   }
   return "?";
 }
@@ -184,13 +189,15 @@ Result<IntegrateStats> IntegrateFrame(const DepthImage& depth, const ColorImage&
   f.max_weight = params.max_weight;
   f.depth_weighting = params.weighting == Weighting::kDepthDependent;
 
-  const auto kernel = ResolveKernel(params.kernel) == Kernel::kSimd ? internal::IntegrateBlockSimd
-                                                                    : internal::IntegrateBlockScalar;
+  const auto kernel = ResolveKernel(params.kernel) == Kernel::kSimd
+                          ? internal::IntegrateBlockSimd
+                          : internal::IntegrateBlockScalar;
   ParallelFor(band.size(), 16, [&](size_t begin, size_t end) {
     for (size_t i = begin; i < end; ++i) kernel(f, band[i], *blocks[i]);
   });
   stats.update_ms = MsSince(t0);
-  for (float d : depth.data) stats.valid_pixels += (d >= params.min_depth_m && d <= params.max_depth_m);
+  for (float d : depth.data)
+    stats.valid_pixels += (d >= params.min_depth_m && d <= params.max_depth_m);
   return stats;
 }
 

@@ -15,8 +15,8 @@ struct FrameView {
   const uint32_t* color = nullptr;  // nullptr: no colour update
   int width = 0, height = 0;
   float fx = 0, fy = 0, cx = 0, cy = 0;
-  float r[9];   // R_C_W row-major
-  float t[3];   // t_C_W
+  float r[9];  // R_C_W row-major
+  float t[3];  // t_C_W
   float min_depth_m = 0, max_depth_m = 0;
   float trunc_m = 0, inv_trunc = 0;
   float voxel_size_m = 0;

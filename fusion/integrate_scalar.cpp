@@ -39,7 +39,8 @@ void IntegrateBlockScalar(const FrameView& f, BlockIndex index, TsdfBlock& block
         const float sum_w = old_w + w_obs;
         const float new_t = (old_t * old_w + tsdf * w_obs) / sum_w;
         const float new_w = std::min(sum_w, f.max_weight);
-        block.tsdf[i] = int16_t(std::nearbyint(std::min(std::max(new_t, -1.0f), 1.0f) * kTsdfScale));
+        block.tsdf[i] =
+            int16_t(std::nearbyint(std::min(std::max(new_t, -1.0f), 1.0f) * kTsdfScale));
         block.weight[i] = uint16_t(std::nearbyint(new_w * kWeightScale));
         // Colour only inside the band: farther voxels see free space, not this surface.
         if (f.color && sdf < f.trunc_m) {

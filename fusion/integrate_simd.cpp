@@ -42,15 +42,18 @@ VOXPLAN_AVX2 void IntegrateBlockSimd(const FrameView& f, BlockIndex index, TsdfB
     for (int y = 0; y < kBlockSide; ++y) {
       const float py = oy + (float(y) + 0.5f) * s;
       // The y and z terms are the same for the whole row; add them in the scalar order.
-      const __m256 cx_ = _mm256_add_ps(
-          _mm256_add_ps(_mm256_add_ps(_mm256_mul_ps(r0, px), Splat(f.r[1] * py)), Splat(f.r[2] * pz)),
-          Splat(f.t[0]));
-      const __m256 cy_ = _mm256_add_ps(
-          _mm256_add_ps(_mm256_add_ps(_mm256_mul_ps(r3, px), Splat(f.r[4] * py)), Splat(f.r[5] * pz)),
-          Splat(f.t[1]));
-      const __m256 cz_ = _mm256_add_ps(
-          _mm256_add_ps(_mm256_add_ps(_mm256_mul_ps(r6, px), Splat(f.r[7] * py)), Splat(f.r[8] * pz)),
-          Splat(f.t[2]));
+      const __m256 cx_ =
+          _mm256_add_ps(_mm256_add_ps(_mm256_add_ps(_mm256_mul_ps(r0, px), Splat(f.r[1] * py)),
+                                      Splat(f.r[2] * pz)),
+                        Splat(f.t[0]));
+      const __m256 cy_ =
+          _mm256_add_ps(_mm256_add_ps(_mm256_add_ps(_mm256_mul_ps(r3, px), Splat(f.r[4] * py)),
+                                      Splat(f.r[5] * pz)),
+                        Splat(f.t[1]));
+      const __m256 cz_ =
+          _mm256_add_ps(_mm256_add_ps(_mm256_add_ps(_mm256_mul_ps(r6, px), Splat(f.r[7] * py)),
+                                      Splat(f.r[8] * pz)),
+                        Splat(f.t[2]));
       __m256 valid = _mm256_cmp_ps(cz_, zero, _CMP_GT_OQ);
       if (_mm256_testz_ps(valid, valid)) continue;
       const __m256 inv_z = _mm256_div_ps(one, cz_);
@@ -64,9 +67,10 @@ VOXPLAN_AVX2 void IntegrateBlockSimd(const FrameView& f, BlockIndex index, TsdfB
       valid = _mm256_and_ps(valid, _mm256_cmp_ps(vf, max_v, _CMP_LE_OQ));
       if (_mm256_testz_ps(valid, valid)) continue;
       // Invalid lanes gather pixel 0 (masked off anyway) so no index is out of range.
-      const __m256i pixel = _mm256_and_si256(
-          _mm256_add_epi32(_mm256_mullo_epi32(_mm256_cvttps_epi32(vf), width), _mm256_cvttps_epi32(uf)),
-          _mm256_castps_si256(valid));
+      const __m256i pixel =
+          _mm256_and_si256(_mm256_add_epi32(_mm256_mullo_epi32(_mm256_cvttps_epi32(vf), width),
+                                            _mm256_cvttps_epi32(uf)),
+                           _mm256_castps_si256(valid));
       const __m256 d = _mm256_mask_i32gather_ps(zero, f.depth, pixel, valid, 4);
       valid = _mm256_and_ps(valid, _mm256_cmp_ps(d, Splat(f.min_depth_m), _CMP_GE_OQ));
       valid = _mm256_and_ps(valid, _mm256_cmp_ps(d, Splat(f.max_depth_m), _CMP_LE_OQ));
@@ -80,10 +84,13 @@ VOXPLAN_AVX2 void IntegrateBlockSimd(const FrameView& f, BlockIndex index, TsdfB
       const int i = LinearIndex(0, y, z);
       const __m128i old_t16 = _mm_loadu_si128(reinterpret_cast<const __m128i*>(&block.tsdf[i]));
       const __m128i old_w16 = _mm_loadu_si128(reinterpret_cast<const __m128i*>(&block.weight[i]));
-      const __m256 old_t = _mm256_mul_ps(_mm256_cvtepi32_ps(_mm256_cvtepi16_epi32(old_t16)), inv_tsdf_scale);
-      const __m256 old_w = _mm256_mul_ps(_mm256_cvtepi32_ps(_mm256_cvtepu16_epi32(old_w16)), inv_w_scale);
+      const __m256 old_t =
+          _mm256_mul_ps(_mm256_cvtepi32_ps(_mm256_cvtepi16_epi32(old_t16)), inv_tsdf_scale);
+      const __m256 old_w =
+          _mm256_mul_ps(_mm256_cvtepi32_ps(_mm256_cvtepu16_epi32(old_w16)), inv_w_scale);
       const __m256 sum_w = _mm256_add_ps(old_w, w_obs);
-      const __m256 new_t = _mm256_div_ps(_mm256_add_ps(_mm256_mul_ps(old_t, old_w), _mm256_mul_ps(tsdf, w_obs)), sum_w);
+      const __m256 new_t = _mm256_div_ps(
+          _mm256_add_ps(_mm256_mul_ps(old_t, old_w), _mm256_mul_ps(tsdf, w_obs)), sum_w);
       const __m256 new_w = _mm256_min_ps(sum_w, Splat(f.max_weight));
       const __m256i t32 = _mm256_cvtps_epi32(
           _mm256_mul_ps(_mm256_min_ps(_mm256_max_ps(new_t, minus_one), one), Splat(kTsdfScale)));
@@ -98,18 +105,20 @@ VOXPLAN_AVX2 void IntegrateBlockSimd(const FrameView& f, BlockIndex index, TsdfB
       if (!f.color) continue;
       const __m256 cmask = _mm256_and_ps(valid, _mm256_cmp_ps(sdf, Splat(f.trunc_m), _CMP_LT_OQ));
       if (_mm256_testz_ps(cmask, cmask)) continue;
-      const __m256i c = _mm256_mask_i32gather_epi32(_mm256_setzero_si256(),
-                                                    reinterpret_cast<const int*>(f.color), pixel,
-                                                    _mm256_castps_si256(cmask), 4);
+      const __m256i c =
+          _mm256_mask_i32gather_epi32(_mm256_setzero_si256(), reinterpret_cast<const int*>(f.color),
+                                      pixel, _mm256_castps_si256(cmask), 4);
       uint8_t* channels[3] = {&block.r[i], &block.g[i], &block.b[i]};
       alignas(32) int32_t out[8];
       alignas(32) int32_t keep[8];
       _mm256_store_si256(reinterpret_cast<__m256i*>(keep), _mm256_castps_si256(cmask));
       for (int k = 0; k < 3; ++k) {
-        const __m256 obs = _mm256_cvtepi32_ps(_mm256_and_si256(_mm256_srli_epi32(c, 8 * k), byte_mask));
+        const __m256 obs =
+            _mm256_cvtepi32_ps(_mm256_and_si256(_mm256_srli_epi32(c, 8 * k), byte_mask));
         const __m128i old8 = _mm_loadl_epi64(reinterpret_cast<const __m128i*>(channels[k]));
         const __m256 old_c = _mm256_cvtepi32_ps(_mm256_cvtepu8_epi32(old8));
-        const __m256 new_c = _mm256_div_ps(_mm256_add_ps(_mm256_mul_ps(old_c, old_w), _mm256_mul_ps(obs, w_obs)), sum_w);
+        const __m256 new_c = _mm256_div_ps(
+            _mm256_add_ps(_mm256_mul_ps(old_c, old_w), _mm256_mul_ps(obs, w_obs)), sum_w);
         _mm256_store_si256(reinterpret_cast<__m256i*>(out), _mm256_cvtps_epi32(new_c));
         for (int x = 0; x < kBlockSide; ++x)
           if (keep[x]) channels[k][x] = uint8_t(out[x]);

@@ -13,7 +13,8 @@ namespace voxplan {
 
 namespace {
 
-constexpr int kGrid = kBlockSide + 1;  // a block's voxels plus the first layer of its +x/+y/+z neighbours
+constexpr int kGrid =
+    kBlockSide + 1;  // a block's voxels plus the first layer of its +x/+y/+z neighbours
 constexpr int kGridCells = kGrid * kGrid * kGrid;
 
 // A block and its +1 neighbour layer copied into one dense 9^3 grid, so every cube's corners
@@ -54,7 +55,8 @@ void FillGrid(const TsdfVolume& volume, BlockIndex b, uint16_t min_weight, Local
 uint64_t EdgeKey(GlobalVoxelIndex g, int axis) {
   constexpr int32_t kBias = 1 << 19;
   VOXPLAN_DASSERT(std::abs(g.x) < kBias && std::abs(g.y) < kBias && std::abs(g.z) < kBias);
-  return uint64_t(uint32_t(g.x + kBias) & 0xfffff) | (uint64_t(uint32_t(g.y + kBias) & 0xfffff) << 20) |
+  return uint64_t(uint32_t(g.x + kBias) & 0xfffff) |
+         (uint64_t(uint32_t(g.y + kBias) & 0xfffff) << 20) |
          (uint64_t(uint32_t(g.z + kBias) & 0xfffff) << 40) | (uint64_t(axis) << 60);
 }
 
@@ -103,8 +105,8 @@ void MeshBlock(const TsdfVolume& volume, BlockIndex b, const MeshParams& params,
             p[axis] += t * s;
             std::array<uint8_t, 3> rgb;
             for (int k = 0; k < 3; ++k)
-              rgb[k] = uint8_t(std::lround(float(grid.rgb[a][k]) +
-                                           t * (float(grid.rgb[bcell][k]) - float(grid.rgb[a][k]))));
+              rgb[k] = uint8_t(std::lround(
+                  float(grid.rgb[a][k]) + t * (float(grid.rgb[bcell][k]) - float(grid.rgb[a][k]))));
             slot = int32_t(out.positions.size());
             out.keys.push_back(EdgeKey(g, axis));
             out.positions.push_back(p);
@@ -113,7 +115,8 @@ void MeshBlock(const TsdfVolume& volume, BlockIndex b, const MeshParams& params,
           vertex_of_edge[e] = uint32_t(slot);
         }
         for (int k = 0; k < mc.num_triangles; ++k)
-          out.triangles.push_back({vertex_of_edge[mc.edges[3 * k]], vertex_of_edge[mc.edges[3 * k + 1]],
+          out.triangles.push_back({vertex_of_edge[mc.edges[3 * k]],
+                                   vertex_of_edge[mc.edges[3 * k + 1]],
                                    vertex_of_edge[mc.edges[3 * k + 2]]});
       }
 }
@@ -126,7 +129,8 @@ Mesh ExtractMesh(const TsdfVolume& volume, const MeshParams& params) {
   ParallelFor(blocks.size(), 8, [&](size_t begin, size_t end) {
     auto grid = std::make_unique<LocalGrid>();
     std::vector<int32_t> edge_vertex(kGridCells * 3);
-    for (size_t i = begin; i < end; ++i) MeshBlock(volume, blocks[i], params, *grid, edge_vertex, parts[i]);
+    for (size_t i = begin; i < end; ++i)
+      MeshBlock(volume, blocks[i], params, *grid, edge_vertex, parts[i]);
   });
 
   // Weld: blocks meet on shared edges, which carry the same key and identical values.
@@ -145,7 +149,8 @@ Mesh ExtractMesh(const TsdfVolume& volume, const MeshParams& params) {
   for (size_t k = 0; k < total; ++k) {
     if (k == 0 || order[k].first != order[k - 1].first) {
       const uint32_t seq = order[k].second;
-      const size_t part = size_t(std::upper_bound(offset.begin(), offset.end(), seq) - offset.begin()) - 1;
+      const size_t part =
+          size_t(std::upper_bound(offset.begin(), offset.end(), seq) - offset.begin()) - 1;
       mesh.positions.push_back(parts[part].positions[seq - offset[part]]);
       if (params.with_color) mesh.colors.push_back(parts[part].colors[seq - offset[part]]);
     }

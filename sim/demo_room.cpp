@@ -10,7 +10,6 @@ namespace {
 
 using Rgb = std::array<uint8_t, 3>;
 
-constexpr float kWallGap_m = 0.02f;  // furniture stays off the walls: no coplanar faces
 constexpr float kCameraHeight_m = 1.4f;
 constexpr double kPi = 3.14159265358979323846;
 
@@ -72,29 +71,22 @@ std::vector<FurniturePiece> Furniture(const DemoRoomParams& params) {
   auto box = [](float x0, float y0, float z0, float x1, float y1, float z1) {
     return Eigen::AlignedBox3f(Eigen::Vector3f(x0, y0, z0), Eigen::Vector3f(x1, y1, z1));
   };
+  // Solid boxes only: a table top on legs has an underside no camera above it can see. Each
+  // piece stands free in the middle, seen from all around, or flush in a corner or against a
+  // wall: the faces it hides against the walls and the floor are hidden in a real room too, and
+  // no gap between furniture and wall hides a face that only a camera in the gap could see.
   std::vector<FurniturePiece> pieces;
-  // Table near the -y wall: a top slab on four legs, so there is free space beneath it.
-  const float tx0 = -0.9f, tx1 = 0.3f, ty0 = -hy + 0.25f, ty1 = -hy + 1.05f;
-  const float leg = 0.06f, table_h = 0.75f, slab = 0.04f;
-  pieces.push_back({box(tx0, ty0, table_h - slab, tx1, ty1, table_h), {205, 155, 100}});
-  const Rgb leg_color = {95, 65, 40};
-  for (int i = 0; i < 4; ++i) {
-    const float x0 = (i & 1) ? tx1 - 0.05f - leg : tx0 + 0.05f;
-    const float y0 = (i & 2) ? ty1 - 0.05f - leg : ty0 + 0.05f;
-    pieces.push_back({box(x0, y0, 0.f, x0 + leg, y0 + leg, table_h - slab), leg_color});
-  }
-  // Cabinet against the +x wall.
-  pieces.push_back({box(hx - kWallGap_m - 0.5f, -hy + 0.3f, 0.f, hx - kWallGap_m, -hy + 1.2f,
-                        std::min(1.0f, 0.6f * top)),
-                    {125, 75, 45}});
-  // Sofa against the -x wall.
+  // Coffee table in the middle of the room: the trajectory circles it, so all four sides show;
+  // low, so the floor behind it shows from across the room.
+  pieces.push_back({box(-0.4f, -0.25f, 0.f, 0.3f, 0.25f, 0.45f), {205, 155, 100}});
+  // Cabinet in the +x -y corner.
   pieces.push_back(
-      {box(-hx + kWallGap_m, -0.2f, 0.f, -hx + kWallGap_m + 0.9f, hy - kWallGap_m - 0.1f, 0.45f),
-       {40, 120, 145}});
-  // Tall shelf against the +y wall.
+      {box(hx - 0.45f, -hy, 0.f, hx, -hy + 0.9f, std::min(1.0f, 0.6f * top)), {125, 75, 45}});
+  // Sofa in the -x +y corner.
+  pieces.push_back({box(-hx, hy - 1.4f, 0.f, -hx + 0.8f, hy, 0.45f), {40, 120, 145}});
+  // Shelf against the +y wall, lower than the camera so its top shows.
   pieces.push_back(
-      {box(-0.2f, hy - kWallGap_m - 0.35f, 0.f, 0.7f, hy - kWallGap_m, std::min(2.0f, top - 0.2f)),
-       {150, 95, 165}});
+      {box(-0.2f, hy - 0.3f, 0.f, 0.7f, hy, std::min(1.1f, 0.6f * top)), {150, 95, 165}});
   return pieces;
 }
 
@@ -124,20 +116,25 @@ std::vector<Pose3d> DemoTrajectory(const DemoRoomParams& params, int frames) {
   std::vector<Pose3d> poses;
   if (frames <= 0) return poses;
   poses.reserve(size_t(frames));
-  // An ellipse a quarter of the room's size out from the centre keeps walls >= 0.7 m away,
-  // above the furniture (all but the shelf are lower than the camera; the shelf is outside it).
-  const double a = 0.25 * params.size_x_m, b = 0.25 * params.size_y_m;
-  const double z = std::min<double>(kCameraHeight_m, 0.6 * params.height_m);
+  // Two laps of an ellipse around the middle table, 0.3 and 0.27 of the room's size out from
+  // the centre: the walls stay >= 0.69 m away, the path passes above the sofa and clear of the
+  // cabinet and shelf.
+  const double a = 0.3 * params.size_x_m, b = 0.27 * params.size_y_m;
+  const double z_mid = std::min<double>(kCameraHeight_m, 0.56 * params.height_m);
   const Eigen::Vector3d up = Eigen::Vector3d::UnitZ();
   for (int i = 0; i < frames; ++i) {
-    const double theta = 2.0 * kPi * double(i) / double(frames);
-    // The heading swings between outwards (theta + 0.5) and ahead along the loop
-    // (theta + 1.9): looking only outwards sees the furniture near the path from above and
-    // never under the table. The pitch dips from 9 to 37 degrees down, so the floor shows.
-    const double yaw = theta + 1.2 + 0.7 * std::sin(2.0 * theta);
-    const double pitch_down = 0.4 + 0.25 * std::sin(2.0 * theta + 0.5);
-    const Eigen::Vector3d forward(std::cos(yaw) * std::cos(pitch_down),
-                                  std::sin(yaw) * std::cos(pitch_down), -std::sin(pitch_down));
+    const double theta = 4.0 * kPi * double(i) / double(frames);
+    // The heading swings around "inwards" (theta + pi), across the room past the table, to
+    // nearly along the loop either way, so every wall and furniture face is seen from the far
+    // side and obliquely from near it. The pitch goes smoothly between 45 degrees down (the
+    // floor near the path and behind the table) and 30 degrees up (ceiling). Both run at
+    // half-integer rates per lap, so the second lap passes each place looking the other way up and
+    // at another heading; the height bobs by 10 cm, once over the two laps.
+    const double yaw = theta + kPi + 1.1 * std::sin(1.5 * theta + 0.3);
+    const double pitch_up = kPi / 180.0 * (-7.5 + 37.5 * std::sin(2.5 * theta + 1.0));
+    const double z = z_mid + 0.1 * std::sin(0.5 * theta);
+    const Eigen::Vector3d forward(std::cos(yaw) * std::cos(pitch_up),
+                                  std::sin(yaw) * std::cos(pitch_up), std::sin(pitch_up));
     const Eigen::Vector3d right = forward.cross(up).normalized();
     const Eigen::Vector3d down = forward.cross(right);
     Pose3d T_W_C = Pose3d::Identity();

@@ -144,7 +144,7 @@ Result<MeshEvalResult> EvaluateMesh(const Mesh& reconstruction, const Mesh& grou
   result.reconstruction_area_m2 = recon->area_m2;
   result.ground_truth_area_m2 = truth->area_m2;
   result.reconstruction_samples = recon_samples.size();
-  result.ground_truth_samples = truth_samples.size();
+  result.ground_truth_samples_all = truth_samples.size();
 
   // Accuracy (eq. 9): reconstruction samples to the ground-truth surface. Samples are equal-area,
   // so the area weights of the paper become a plain mean.
@@ -159,12 +159,33 @@ Result<MeshEvalResult> EvaluateMesh(const Mesh& reconstruction, const Mesh& grou
   result.accuracy_median_m = Median(accuracy);
 
   // Completeness (eq. 10-11): share of ground-truth samples with a reconstruction within
-  // threshold_m.
+  // threshold_m, over all of them and over those the filter keeps (the observable surface).
+  std::vector<uint8_t> kept(truth_samples.size(), 1);
+  if (params.ground_truth_filter) {
+    ParallelFor(truth_samples.size(), kQueryGrain, [&](size_t begin, size_t end) {
+      for (size_t i = begin; i < end; ++i) {
+        const Point& p = truth_samples[i];
+        kept[i] =
+            params.ground_truth_filter(Eigen::Vector3f(float(p.x()), float(p.y()), float(p.z())))
+                ? 1
+                : 0;
+      }
+    });
+  }
+  const size_t kept_count = size_t(std::count(kept.begin(), kept.end(), uint8_t(1)));
+  if (kept_count == 0)
+    return InvalidArgument("EvaluateMesh: ground_truth_filter keeps no ground-truth sample");
   const std::vector<double> coverage = DistancesTo(*recon, truth_samples);
   const double threshold = double(params.threshold_m);
-  const size_t covered = size_t(
-      std::count_if(coverage.begin(), coverage.end(), [&](double d) { return d < threshold; }));
-  result.completeness = double(covered) / double(coverage.size());
+  size_t covered = 0, covered_kept = 0;
+  for (size_t i = 0; i < coverage.size(); ++i) {
+    if (!(coverage[i] < threshold)) continue;
+    ++covered;
+    covered_kept += kept[i];
+  }
+  result.ground_truth_samples = kept_count;
+  result.completeness = double(covered_kept) / double(kept_count);
+  result.completeness_all = double(covered) / double(coverage.size());
   return result;
 }
 

@@ -2,8 +2,11 @@
 // Reconstruction vs ground truth, Dong et al. 2019 eq. 9-10 with area-weighted samples:
 // accuracy = distances from samples on the reconstruction to the ground-truth surface (mean, RMS),
 // completeness = fraction of ground-truth samples within `threshold_m` of the reconstruction.
-// Point-to-triangle distances through CGAL AABB trees.
+// Point-to-triangle distances through CGAL AABB trees. An optional filter restricts completeness
+// to the ground truth a sensor could have seen (sim/visibility.h builds one from a trajectory).
+#include <Eigen/Core>
 #include <cstdint>
+#include <functional>
 
 #include "core/mesh.h"
 #include "core/status.h"
@@ -14,20 +17,25 @@ struct MeshEvalParams {
   float threshold_m = 0.05f;
   float samples_per_m2 = 10000.0f;
   uint64_t seed = 1;
+  // Which ground-truth samples (world frame) count for `completeness`; empty: all of them.
+  // Called from several threads at once, so it must be safe to call concurrently.
+  std::function<bool(const Eigen::Vector3f&)> ground_truth_filter;
 };
 
 struct MeshEvalResult {
   double accuracy_mean_m = 0.0;
   double accuracy_rms_m = 0.0;
   double accuracy_median_m = 0.0;
-  double completeness = 0.0;  // 0..1
+  double completeness = 0.0;      // 0..1, over the samples ground_truth_filter keeps
+  double completeness_all = 0.0;  // 0..1, over every ground-truth sample
   double reconstruction_area_m2 = 0.0;
   double ground_truth_area_m2 = 0.0;
   size_t reconstruction_samples = 0;
-  size_t ground_truth_samples = 0;
+  size_t ground_truth_samples = 0;      // kept by ground_truth_filter
+  size_t ground_truth_samples_all = 0;  // before the filter
 };
 
-// Refuses empty meshes.
+// Refuses empty meshes, and a filter that keeps no ground-truth sample.
 Result<MeshEvalResult> EvaluateMesh(const Mesh& reconstruction, const Mesh& ground_truth,
                                     const MeshEvalParams& params = {});
 

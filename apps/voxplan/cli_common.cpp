@@ -196,4 +196,17 @@ Status WriteJsonFile(const nlohmann::json& json, const std::string& path) {
 
 void PrintJsonLine(const nlohmann::json& json) { std::cout << json.dump() << std::endl; }
 
+void AddMapStats(nlohmann::json& j, const TsdfVolume& volume) {
+  j["blocks"] = volume.num_blocks();
+  j["voxels"] = volume.num_voxels();
+  j["bytes_per_voxel"] = TsdfVolume::BytesPerVoxel();
+  j["map_mb"] = Mib(volume.MemoryBytes());
+}
+
+void AddMeshStats(nlohmann::json& j, const Mesh& mesh, double mesh_ms) {
+  j["mesh_vertices"] = mesh.num_vertices();
+  j["mesh_triangles"] = mesh.num_triangles();
+  j["mesh_ms"] = RoundTo(mesh_ms, 3);
+}
+
 }  // namespace voxplan::cli

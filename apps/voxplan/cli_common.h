@@ -10,7 +10,9 @@
 #include <vector>
 
 #include "core/camera.h"
+#include "core/mesh.h"
 #include "core/status.h"
+#include "core/volume.h"
 
 namespace voxplan::cli {
 
@@ -86,6 +88,11 @@ class Progress {
 };
 
 double PeakRssMb();  // MiB, from getrusage
+
+// The map's size keys (blocks, voxels, bytes_per_voxel, map_mb) and the mesh keys
+// (mesh_vertices, mesh_triangles, mesh_ms) every command that builds them reports alike.
+void AddMapStats(nlohmann::json& j, const TsdfVolume& volume);
+void AddMeshStats(nlohmann::json& j, const Mesh& mesh, double mesh_ms);
 double RoundTo(double value, int decimals);
 // A float as the double with the same shortest decimal form (0.02f -> 0.02, not 0.0199999...).
 double FloatValue(float value);

@@ -191,12 +191,18 @@ int RunFuse(const FuseOptions& o) {
   if (!o.frame_list_path.empty()) {
     // Exactly the frames integrated, with the parameters, for reference runs of other
     // pipelines (bench/open3d_fusion.py) on identical input.
-    nlohmann::json list = {{"width", info.camera.width},     {"height", info.camera.height},
-                           {"fx", FloatValue(info.camera.fx)}, {"fy", FloatValue(info.camera.fy)},
-                           {"cx", FloatValue(info.camera.cx)}, {"cy", FloatValue(info.camera.cy)},
-                           {"depth_scale", info.depth_scale},  {"voxel_size_m", o.voxel_size_m},
-                           {"trunc_m", o.trunc_m},             {"min_depth_m", o.min_depth_m},
-                           {"max_depth_m", o.max_depth_m},     {"frames", frame_list}};
+    nlohmann::json list = {{"width", info.camera.width},
+                           {"height", info.camera.height},
+                           {"fx", FloatValue(info.camera.fx)},
+                           {"fy", FloatValue(info.camera.fy)},
+                           {"cx", FloatValue(info.camera.cx)},
+                           {"cy", FloatValue(info.camera.cy)},
+                           {"depth_scale", info.depth_scale},
+                           {"voxel_size_m", o.voxel_size_m},
+                           {"trunc_m", o.trunc_m},
+                           {"min_depth_m", o.min_depth_m},
+                           {"max_depth_m", o.max_depth_m},
+                           {"frames", frame_list}};
     if (Status s = WriteJsonFile(list, o.frame_list_path); !s.ok())
       return Fail(MessageNaming(s, o.frame_list_path));
   }
@@ -235,13 +241,8 @@ int RunFuse(const FuseOptions& o) {
   j["loop_s"] = RoundTo(loop_s, 3);
   // Throughput of the whole frame loop (decode + integrate + skipped frames).
   j["fps"] = RoundTo(loop_s > 0 ? double(integrated) / loop_s : 0.0, 2);
-  j["blocks"] = volume.num_blocks();
-  j["voxels"] = volume.num_voxels();
-  j["bytes_per_voxel"] = TsdfVolume::BytesPerVoxel();
-  j["map_mb"] = Mib(volume.MemoryBytes());
-  j["mesh_vertices"] = mesh.num_vertices();
-  j["mesh_triangles"] = mesh.num_triangles();
-  j["mesh_ms"] = RoundTo(mesh_ms, 3);
+  AddMapStats(j, volume);
+  AddMeshStats(j, mesh, mesh_ms);
   j["mesh"] = OrNull(o.mesh_path);
   j["map"] = OrNull(o.map_path);
   j["stats"] = OrNull(o.stats_path);

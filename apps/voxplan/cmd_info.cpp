@@ -95,12 +95,9 @@ int MapInfoCommand(const InfoOptions& o) {
   j["version"] = header->version;
   j["voxel_size_m"] = FloatValue(header->params.voxel_size_m);
   j["trunc_m"] = FloatValue(header->params.trunc_m);
-  j["blocks"] = header->num_blocks;
-  j["voxels"] = volume->num_voxels();
+  AddMapStats(j, *volume);
   j["observed_voxels"] = observed;
-  j["bytes_per_voxel"] = TsdfVolume::BytesPerVoxel();
   j["memory_bytes"] = volume->MemoryBytes();
-  j["map_mb"] = Mib(volume->MemoryBytes());
   j["file_bytes"] = ec ? 0 : size_t(file_bytes);
   PrintJsonLine(j);
   return kExitOk;

@@ -49,13 +49,11 @@ int RunMesh(const MeshOptions& o) {
   j["out"] = o.out_path;
   j["voxel_size_m"] = FloatValue(volume->voxel_size_m());
   j["trunc_m"] = FloatValue(volume->trunc_m());
-  j["blocks"] = volume->num_blocks();
   j["min_weight"] = o.min_weight;
   j["threads"] = MaxThreads();
   j["load_ms"] = RoundTo(load_ms, 3);
-  j["mesh_ms"] = RoundTo(mesh_ms, 3);
-  j["mesh_vertices"] = mesh.num_vertices();
-  j["mesh_triangles"] = mesh.num_triangles();
+  AddMapStats(j, *volume);
+  AddMeshStats(j, mesh, mesh_ms);
   std::cerr << "mesh: " << o.out_path << " (" << mesh.num_vertices() << " vertices, "
             << mesh.num_triangles() << " triangles) from " << volume->num_blocks() << " blocks in "
             << j["mesh_ms"] << " ms\n";

@@ -29,8 +29,8 @@ TEST(Index, LinearIndexRoundTripAndRowsAreContiguous) {
 
 TEST(Index, PackUnpackRoundTripIncludingExtremes) {
   const int32_t m = kMaxBlockCoord;
-  for (BlockIndex b : {BlockIndex{0, 0, 0}, BlockIndex{-1, 2, -3}, BlockIndex{m, -m, m},
-                       BlockIndex{-m, m, -1}}) {
+  for (BlockIndex b :
+       {BlockIndex{0, 0, 0}, BlockIndex{-1, 2, -3}, BlockIndex{m, -m, m}, BlockIndex{-m, m, -1}}) {
     EXPECT_TRUE(InPackRange(b));
     EXPECT_EQ(UnpackBlockIndex(PackBlockIndex(b)), b);
   }

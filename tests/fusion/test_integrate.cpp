@@ -61,7 +61,8 @@ void ExpectTsdfMatchesSdf(const TsdfVolume& volume, const Scene& scene, size_t m
   });
   ASSERT_GE(errors.size(), min_checked);
   const auto [median, p95] = MedianAndP95(errors);
-  std::printf("tsdf error (voxels): median %.4f p95 %.4f over %zu voxels\n", median, p95, errors.size());
+  std::printf("tsdf error (voxels): median %.4f p95 %.4f over %zu voxels\n", median, p95,
+              errors.size());
   EXPECT_LT(median, max_median_vox);
   EXPECT_LT(p95, 3 * max_median_vox);
 }
@@ -91,8 +92,8 @@ TEST(Integrate, SphereFromSixViews) {
   std::vector<Pose3f> poses;
   for (int k = 0; k < 6; ++k) {
     const float a = float(k) * 2.0f * float(M_PI) / 6.0f;
-    poses.push_back(LookAt(sphere.c + Eigen::Vector3f(1.5f * std::cos(a), 1.5f * std::sin(a), 0.3f),
-                           sphere.c));
+    poses.push_back(
+        LookAt(sphere.c + Eigen::Vector3f(1.5f * std::cos(a), 1.5f * std::sin(a), 0.3f), sphere.c));
   }
   const TsdfVolume volume = FuseViews(sphere, poses);
   ExpectTsdfMatchesSdf(volume, sphere, 2000, kMaxObliqueSdfErrorVox);
@@ -101,9 +102,9 @@ TEST(Integrate, SphereFromSixViews) {
 
 TEST(Integrate, BoxCornerView) {
   const test::Box box{Eigen::Vector3f(-0.3f, -0.2f, -0.25f), Eigen::Vector3f(0.3f, 0.2f, 0.25f)};
-  const TsdfVolume volume = FuseViews(
-      box, {LookAt({1.2f, 0.9f, 0.8f}, {0, 0, 0}), LookAt({-1.1f, 1.0f, 0.7f}, {0, 0, 0}),
-            LookAt({0.2f, -1.3f, 0.9f}, {0, 0, 0})});
+  const TsdfVolume volume =
+      FuseViews(box, {LookAt({1.2f, 0.9f, 0.8f}, {0, 0, 0}), LookAt({-1.1f, 1.0f, 0.7f}, {0, 0, 0}),
+                      LookAt({0.2f, -1.3f, 0.9f}, {0, 0, 0})});
   // Near edges the projective distance differs from the Euclidean one; check face interiors
   // (points at least two voxels from every edge of the box).
   const Mesh mesh = ExtractMesh(volume);
@@ -126,8 +127,8 @@ TEST(Integrate, DepthRangeAndInvalidPixelsAreSkipped) {
   const PinholeCamera cam = TestCamera(64, 48);
   DepthImage depth(cam.width, cam.height, 0.0f);
   for (int u = 0; u < 32; ++u)
-    for (int v = 0; v < cam.height; ++v) depth.at(u, v) = 1.0f;                         // valid
-  for (int v = 0; v < cam.height; ++v) depth.at(40, v) = 5.0f;                          // too far
+    for (int v = 0; v < cam.height; ++v) depth.at(u, v) = 1.0f;  // valid
+  for (int v = 0; v < cam.height; ++v) depth.at(40, v) = 5.0f;   // too far
   for (int v = 0; v < cam.height; ++v) depth.at(50, v) = std::numeric_limits<float>::quiet_NaN();
   IntegrateParams params;
   params.max_depth_m = 3.0f;
@@ -140,9 +141,9 @@ TEST(Integrate, DepthRangeAndInvalidPixelsAreSkipped) {
   EXPECT_EQ(StateAt(volume, far_point), VoxelState::kUnobserved);
   // All-invalid frame: no blocks, no error.
   TsdfVolume empty({kVoxel, kTrunc});
-  ASSERT_TRUE(IntegrateFrame(DepthImage(64, 48, 0.f), ColorImage{}, cam, Pose3f::Identity(), params,
-                             empty)
-                  .ok());
+  ASSERT_TRUE(
+      IntegrateFrame(DepthImage(64, 48, 0.f), ColorImage{}, cam, Pose3f::Identity(), params, empty)
+          .ok());
   EXPECT_EQ(empty.num_blocks(), 0u);
 }
 
@@ -184,14 +185,20 @@ TEST(Integrate, ColourIsFusedNearTheSurface) {
 TEST(Integrate, RefusesMismatchedInputs) {
   const PinholeCamera cam = TestCamera(32, 24);
   TsdfVolume volume({kVoxel, kTrunc});
-  EXPECT_FALSE(IntegrateFrame(DepthImage(31, 24, 1.f), ColorImage{}, cam, Pose3f::Identity(), {}, volume).ok());
-  EXPECT_FALSE(IntegrateFrame(DepthImage(32, 24, 1.f), ColorImage(16, 12), cam, Pose3f::Identity(), {}, volume).ok());
+  EXPECT_FALSE(
+      IntegrateFrame(DepthImage(31, 24, 1.f), ColorImage{}, cam, Pose3f::Identity(), {}, volume)
+          .ok());
+  EXPECT_FALSE(IntegrateFrame(DepthImage(32, 24, 1.f), ColorImage(16, 12), cam, Pose3f::Identity(),
+                              {}, volume)
+                   .ok());
   Pose3f bad = Pose3f::Identity();
   bad.translation().x() = std::numeric_limits<float>::quiet_NaN();
   EXPECT_FALSE(IntegrateFrame(DepthImage(32, 24, 1.f), ColorImage{}, cam, bad, {}, volume).ok());
   IntegrateParams params;
   params.max_weight = 1000.f;
-  EXPECT_FALSE(IntegrateFrame(DepthImage(32, 24, 1.f), ColorImage{}, cam, Pose3f::Identity(), params, volume).ok());
+  EXPECT_FALSE(
+      IntegrateFrame(DepthImage(32, 24, 1.f), ColorImage{}, cam, Pose3f::Identity(), params, volume)
+          .ok());
 }
 
 }  // namespace

@@ -28,8 +28,8 @@ Sequence MakeSequence() {
   const test::Plane floor{Eigen::Vector3f(0, 0, 1), 0.0f};
   for (int k = 0; k < 5; ++k) {
     const float a = 0.4f + float(k) * 0.5f;
-    const Pose3f T_W_C = test::LookAt(
-        Eigen::Vector3f(1.4f * std::cos(a), 1.4f * std::sin(a), 0.9f), Eigen::Vector3f(0, 0, 0.3f));
+    const Pose3f T_W_C = test::LookAt(Eigen::Vector3f(1.4f * std::cos(a), 1.4f * std::sin(a), 0.9f),
+                                      Eigen::Vector3f(0, 0, 0.3f));
     DepthImage ds = test::RenderDepth(sphere, seq.cam, T_W_C);
     const DepthImage df = test::RenderDepth(floor, seq.cam, T_W_C);
     ColorImage col(seq.cam.width, seq.cam.height);
@@ -157,7 +157,8 @@ TEST(CompactEncoding, MatchesAFloatReferenceIntegrator) {
   // Eigen's float projection can round a voxel onto the neighbouring pixel at a pixel border,
   // which is not an encoding error: allow that for a tiny fraction of voxels.
   const size_t allowed = reference.size() / 1000;
-  EXPECT_LE(tsdf_off, allowed) << "voxels off by more than " << kMaxQuantisationErrorVox << " voxel";
+  EXPECT_LE(tsdf_off, allowed) << "voxels off by more than " << kMaxQuantisationErrorVox
+                               << " voxel";
   EXPECT_LE(weight_mismatch, allowed);
   RecordProperty("worst_quantisation_error_vox", std::to_string(worst_vox));
 }

@@ -58,9 +58,9 @@ TEST(MarchingCubes, TableCoversEveryCaseConsistently) {
     EXPECT_GT(table[i].num_triangles, 0) << "case " << i;
     EXPECT_LE(table[i].num_triangles, 12) << "case " << i;
   }
-  EXPECT_EQ(table[1].num_triangles, 1);    // one corner inside: one triangle
-  EXPECT_EQ(table[3].num_triangles, 2);    // one edge inside: a quad
-  EXPECT_EQ(table[15].num_triangles, 2);   // half the cube: a quad
+  EXPECT_EQ(table[1].num_triangles, 1);   // one corner inside: one triangle
+  EXPECT_EQ(table[3].num_triangles, 2);   // one edge inside: a quad
+  EXPECT_EQ(table[15].num_triangles, 2);  // half the cube: a quad
 }
 
 TEST(MarchingCubes, SphereIsClosedOnTheSurfaceWithTheRightArea) {
@@ -85,7 +85,8 @@ TEST(MarchingCubes, SphereIsClosedOnTheSurfaceWithTheRightArea) {
   float worst = 0.f, worst_normal = 1.f;
   for (size_t i = 0; i < mesh.positions.size(); ++i) {
     worst = std::max(worst, std::abs(sdf(mesh.positions[i])));
-    worst_normal = std::min(worst_normal, mesh.normals[i].dot((mesh.positions[i] - c).normalized()));
+    worst_normal =
+        std::min(worst_normal, mesh.normals[i].dot((mesh.positions[i] - c).normalized()));
   }
   EXPECT_LT(worst, kMaxDistanceVox * voxel);
   EXPECT_GT(worst_normal, 0.98f) << "normals point outwards";

@@ -31,6 +31,8 @@ TEST(EvaluateMesh, IdenticalMeshesArePerfect) {
   EXPECT_NEAR(result->ground_truth_area_m2, 1.0, 1e-9);
   EXPECT_EQ(result->reconstruction_samples, 10000u);  // ceil(area * samples_per_m2)
   EXPECT_EQ(result->ground_truth_samples, 10000u);
+  EXPECT_EQ(result->ground_truth_samples_all, 10000u);
+  EXPECT_DOUBLE_EQ(result->completeness_all, 1.0);
 }
 
 TEST(EvaluateMesh, ShiftAlongNormalIsTheAccuracy) {
@@ -66,6 +68,39 @@ TEST(EvaluateMesh, HalfReconstructionIsHalfComplete) {
   ASSERT_TRUE(extra.ok());
   EXPECT_DOUBLE_EQ(extra->completeness, 1.0);
   EXPECT_NEAR(extra->accuracy_mean_m, 0.125, 0.01);
+}
+
+TEST(EvaluateMesh, GroundTruthFilterRestrictsCompleteness) {
+  MeshEvalParams params;
+  params.threshold_m = 0.005f;
+  const Mesh half = Rectangle(0.f, 0.f, 0.5f, 1.f, 0.f);
+  auto unfiltered = EvaluateMesh(half, UnitSquare(), params);
+  ASSERT_TRUE(unfiltered.ok()) << unfiltered.status().message();
+  EXPECT_EQ(unfiltered->completeness, unfiltered->completeness_all);
+  EXPECT_EQ(unfiltered->ground_truth_samples, unfiltered->ground_truth_samples_all);
+
+  // Only the half that was reconstructed counts: complete there, half complete overall.
+  params.ground_truth_filter = [](const Eigen::Vector3f& p) { return p.x() < 0.5f; };
+  auto filtered = EvaluateMesh(half, UnitSquare(), params);
+  ASSERT_TRUE(filtered.ok()) << filtered.status().message();
+  EXPECT_DOUBLE_EQ(filtered->completeness, 1.0);
+  EXPECT_EQ(filtered->completeness_all, unfiltered->completeness_all);
+  EXPECT_NEAR(filtered->completeness_all, 0.5, kShareTolerance);
+  EXPECT_EQ(filtered->ground_truth_samples_all, 10000u);
+  EXPECT_NEAR(double(filtered->ground_truth_samples), 5000.0, 10000.0 * kShareTolerance);
+  // Accuracy does not depend on the filter.
+  EXPECT_EQ(filtered->accuracy_rms_m, unfiltered->accuracy_rms_m);
+
+  // The other half only: nothing of it was reconstructed.
+  params.ground_truth_filter = [](const Eigen::Vector3f& p) { return p.x() > 0.51f; };
+  auto other = EvaluateMesh(half, UnitSquare(), params);
+  ASSERT_TRUE(other.ok());
+  EXPECT_DOUBLE_EQ(other->completeness, 0.0);
+
+  params.ground_truth_filter = [](const Eigen::Vector3f&) { return false; };
+  auto none = EvaluateMesh(half, UnitSquare(), params);
+  ASSERT_FALSE(none.ok());
+  EXPECT_EQ(none.status().code(), StatusCode::kInvalidArgument);
 }
 
 TEST(EvaluateMesh, RefusesEmptyMeshes) {

@@ -1,10 +1,11 @@
 #include "tests/support/test_support.h"
 
+#include <unistd.h>
+
 #include <atomic>
 #include <cmath>
 #include <cstdlib>
 #include <limits>
-#include <unistd.h>
 
 namespace voxplan::test {
 
@@ -98,7 +99,8 @@ DepthImage RenderDepth(const Box& s, const PinholeCamera& cam, const Pose3f& T_W
   return Render(cam, T_W_C, [&](auto& o, auto& d) { return HitBox(s, o, d); });
 }
 
-Pose3f LookAt(const Eigen::Vector3f& eye, const Eigen::Vector3f& target, const Eigen::Vector3f& up) {
+Pose3f LookAt(const Eigen::Vector3f& eye, const Eigen::Vector3f& target,
+              const Eigen::Vector3f& up) {
   const Eigen::Vector3f z = (target - eye).normalized();
   Eigen::Vector3f x = z.cross(up);
   if (x.norm() < 1e-6f) x = z.cross(Eigen::Vector3f::UnitX());

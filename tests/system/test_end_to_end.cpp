@@ -33,8 +33,8 @@ TEST(EndToEnd, IclNuimFusedWithGroundTruthPosesMatchesTheInputDepth) {
     auto frame = (*dataset)->Load(i);
     ASSERT_TRUE(frame.ok()) << frame.status().message();
     if (!frame->T_W_C) continue;
-    auto stats = IntegrateFrame(frame->depth, frame->color, camera, frame->T_W_C->cast<float>(), {},
-                                volume);
+    auto stats =
+        IntegrateFrame(frame->depth, frame->color, camera, frame->T_W_C->cast<float>(), {}, volume);
     ASSERT_TRUE(stats.ok()) << stats.status().message();
     if (i == 10 || i == 35 || i == 59) checked.push_back(std::move(*frame));
   }
@@ -63,7 +63,8 @@ TEST(EndToEnd, IclNuimFusedWithGroundTruthPosesMatchesTheInputDepth) {
     std::printf("frame %zu: %zu of %zu pixels covered, median |depth error| %.4f m\n", frame.index,
                 errors.size(), in_range, median);
     EXPECT_LT(median, kMaxMedianDepthErrorM) << "frame " << frame.index;
-    EXPECT_GT(float(agreeing) / float(errors.size()), kMinAgreeingFraction) << "frame " << frame.index;
+    EXPECT_GT(float(agreeing) / float(errors.size()), kMinAgreeingFraction)
+        << "frame " << frame.index;
   }
 }
 
