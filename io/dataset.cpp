@@ -14,6 +14,7 @@
 #include <sstream>
 #include <utility>
 
+#include "io/file_util.h"
 #include "io/image_io.h"
 
 namespace voxplan {
@@ -54,19 +55,8 @@ struct TextFile {
   std::vector<TextLine> lines;
 };
 
-Result<std::string> ReadWholeFile(const std::string& path) {
-  std::error_code ec;
-  if (!fs::exists(path, ec)) return NotFound(path + ": file not found");
-  if (fs::is_directory(path, ec)) return InvalidArgument(path + ": is a folder, expected a file");
-  std::ifstream in(path, std::ios::binary);
-  if (!in) return IoError(path + ": cannot open (" + std::strerror(errno) + ")");
-  std::string content((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-  if (in.bad()) return IoError(path + ": read failed");
-  return content;
-}
-
 Result<TextFile> ReadTextFile(const std::string& path) {
-  auto content = ReadWholeFile(path);
+  auto content = ReadFileToString(path);
   if (!content.ok()) return content.status();
   const std::string& s = *content;
   TextFile file;
@@ -568,7 +558,7 @@ Result<Draft> ReadIclNuim(const fs::path& root) {
 // JSON helpers (Redwood camera file, Replica cam_params.json).
 
 Result<nlohmann::json> ReadJson(const std::string& path) {
-  auto content = ReadWholeFile(path);
+  auto content = ReadFileToString(path);
   if (!content.ok()) return content.status();
   std::string_view text = *content;
   if (text.substr(0, 3) == "\xEF\xBB\xBF") text.remove_prefix(3);
@@ -683,7 +673,7 @@ Result<Draft> ReadRedwood(const fs::path& root) {
   if (!jsons.ok()) return jsons.status();
   std::string camera_json;
   for (const std::string& j : *jsons) {  // the first one holding an intrinsic matrix
-    auto content = ReadWholeFile(j);
+    auto content = ReadFileToString(j);
     if (content.ok() && content->find("intrinsic_matrix") != std::string::npos) {
       camera_json = j;
       break;

@@ -412,7 +412,7 @@ TEST(DatasetsBadInput, TumListsAndPoses) {
     test::TempDir dir("tum_bad");
     MakeTumFolder(dir.path());
     fs::remove(dir / "depth.txt");
-    ExpectError(OpenDataset(dir.path().string()).status(), {"depth.txt", "not found"});
+    ExpectError(OpenDataset(dir.path().string()).status(), {"depth.txt", "no such file"});
   }
   {
     SCOPED_TRACE("missing folder");
