@@ -57,15 +57,20 @@ constexpr VoxelIndex VoxelOfLinear(int i) {
   return {i & kBlockMask, (i >> kBlockShift) & kBlockMask, i >> (2 * kBlockShift)};
 }
 
+// floor() as an int without a libm call (portable x86-64 builds have no SSE4.1 round
+// instruction, and std::floor then costs a function call). Exact for |x| < 2^31.
+constexpr int32_t FloorToInt(float x) {
+  const int32_t i = int32_t(x);
+  return i - int32_t(x < float(i));
+}
+
 inline GlobalVoxelIndex VoxelAt(const Eigen::Vector3f& p_W, float voxel_size_m) {
   const float inv = 1.0f / voxel_size_m;
-  return {int32_t(std::floor(p_W.x() * inv)), int32_t(std::floor(p_W.y() * inv)),
-          int32_t(std::floor(p_W.z() * inv))};
+  return {FloorToInt(p_W.x() * inv), FloorToInt(p_W.y() * inv), FloorToInt(p_W.z() * inv)};
 }
 inline BlockIndex BlockAt(const Eigen::Vector3f& p_W, float block_size_m) {
   const float inv = 1.0f / block_size_m;
-  return {int32_t(std::floor(p_W.x() * inv)), int32_t(std::floor(p_W.y() * inv)),
-          int32_t(std::floor(p_W.z() * inv))};
+  return {FloorToInt(p_W.x() * inv), FloorToInt(p_W.y() * inv), FloorToInt(p_W.z() * inv)};
 }
 inline Eigen::Vector3f VoxelCenter(GlobalVoxelIndex g, float voxel_size_m) {
   return {(float(g.x) + 0.5f) * voxel_size_m, (float(g.y) + 0.5f) * voxel_size_m,

@@ -30,8 +30,7 @@ std::optional<VoxelValue> Interpolate(const TsdfVolume& volume, const Eigen::Vec
   const float s = volume.voxel_size_m();
   // Continuous voxel coordinates with voxel centres at integers.
   const Eigen::Vector3f q = p_W / s - Eigen::Vector3f::Constant(0.5f);
-  const GlobalVoxelIndex base{int32_t(std::floor(q.x())), int32_t(std::floor(q.y())),
-                              int32_t(std::floor(q.z()))};
+  const GlobalVoxelIndex base{FloorToInt(q.x()), FloorToInt(q.y()), FloorToInt(q.z())};
   const Eigen::Vector3f f = q - Eigen::Vector3f(float(base.x), float(base.y), float(base.z));
   VoxelValue out;
   const TsdfBlock* cached = nullptr;

@@ -24,8 +24,8 @@ template <typename F>
 void ForEachBlockOnSegment(const Eigen::Vector3f& a, const Eigen::Vector3f& b, float inv_block,
                            F&& visit) {
   const Eigen::Vector3f pa = a * inv_block, pb = b * inv_block;
-  int cell[3] = {int(std::floor(pa.x())), int(std::floor(pa.y())), int(std::floor(pa.z()))};
-  const int last[3] = {int(std::floor(pb.x())), int(std::floor(pb.y())), int(std::floor(pb.z()))};
+  int cell[3] = {FloorToInt(pa.x()), FloorToInt(pa.y()), FloorToInt(pa.z())};
+  const int last[3] = {FloorToInt(pb.x()), FloorToInt(pb.y()), FloorToInt(pb.z())};
   const Eigen::Vector3f dir = pb - pa;
   int step[3];
   float t_max[3], t_delta[3];
@@ -96,8 +96,12 @@ std::vector<BlockIndex> BlocksInTruncationBand(const DepthImage& depth, const Pi
                                                const VolumeParams& volume_params) {
   const float trunc = volume_params.trunc_m;
   const float inv_block = 1.0f / (volume_params.voxel_size_m * kBlockSide);
-  const Eigen::Matrix3f R = T_W_C.linear();
-  const Eigen::Vector3f t = T_W_C.translation();
+  // Work in block units: a pixel's ray is dir(u, v) * z + origin, with dir linear in u and v.
+  const Eigen::Matrix3f R_b = T_W_C.linear() * inv_block;
+  const Eigen::Vector3f origin_b = T_W_C.translation() * inv_block;
+  const Eigen::Vector3f du_b = R_b.col(0) / camera.fx;
+  const Eigen::Vector3f dv_b = R_b.col(1) / camera.fy;
+  const Eigen::Vector3f d0_b = R_b.col(2) - du_b * camera.cx - dv_b * camera.cy;
 
   std::vector<uint64_t> keys;
   std::mutex keys_mutex;
@@ -106,26 +110,45 @@ std::vector<BlockIndex> BlocksInTruncationBand(const DepthImage& depth, const Pi
   ParallelFor(tasks, 1, [&](size_t begin, size_t end) {
     // Neighbouring pixels hit the same blocks: a small direct-mapped cache drops most repeats
     // before the global sort.
-    constexpr size_t kCache = 1024;
-    std::vector<uint64_t> cache(kCache, ~0ull);
+    constexpr int kCacheBits = 10;
+    std::vector<uint64_t> cache(size_t(1) << kCacheBits, ~0ull);
     std::vector<uint64_t> local;
+    auto add = [&](BlockIndex block) {
+      if (!InPackRange(block)) return;
+      const uint64_t key = PackBlockIndex(block);
+      // Fibonacci hashing: the top bits of key * 2^64/phi spread neighbouring blocks apart.
+      uint64_t& slot = cache[(key * 0x9E3779B97F4A7C15ull) >> (64 - kCacheBits)];
+      if (slot == key) return;
+      slot = key;
+      local.push_back(key);
+    };
     for (size_t task = begin; task < end; ++task) {
       const int v_end = std::min<int>(depth.height, int((task + 1) * kRowsPerTask));
       for (int v = int(task * kRowsPerTask); v < v_end; ++v) {
+        const Eigen::Vector3f row_b = d0_b + dv_b * float(v);
+        const float* depth_row = &depth.data[size_t(v) * size_t(depth.width)];
+        BlockIndex prev_a{kMaxBlockCoord + 1, 0, 0}, prev_b = prev_a;
         for (int u = 0; u < depth.width; ++u) {
-          const float d = depth.at(u, v);
+          const float d = depth_row[u];
           if (!(d >= params.min_depth_m && d <= params.max_depth_m)) continue;
-          const Eigen::Vector3f ray_C = camera.Unproject(float(u), float(v), 1.0f);
-          const Eigen::Vector3f a = R * (ray_C * std::max(d - trunc, 1e-3f)) + t;
-          const Eigen::Vector3f b = R * (ray_C * (d + trunc)) + t;
-          ForEachBlockOnSegment(a, b, inv_block, [&](BlockIndex block) {
-            if (!InPackRange(block)) return;
-            const uint64_t key = PackBlockIndex(block);
-            uint64_t& slot = cache[(key ^ (key >> 21) ^ (key >> 42)) & (kCache - 1)];
-            if (slot == key) return;
-            slot = key;
-            local.push_back(key);
-          });
+          const Eigen::Vector3f dir_b = row_b + du_b * float(u);
+          const Eigen::Vector3f a = dir_b * std::max(d - trunc, 1e-3f) + origin_b;
+          const Eigen::Vector3f b = dir_b * (d + trunc) + origin_b;
+          const BlockIndex ba{FloorToInt(a.x()), FloorToInt(a.y()), FloorToInt(a.z())};
+          const BlockIndex bb{FloorToInt(b.x()), FloorToInt(b.y()), FloorToInt(b.z())};
+          // Neighbouring pixels mostly start and end in the same blocks as the previous one.
+          if (ba == prev_a && bb == prev_b) continue;
+          prev_a = ba;
+          prev_b = bb;
+          // The band is one block long: mostly it stays in one block or crosses one face, and
+          // then the traversal is exactly {ba, bb} without stepping through it.
+          const int steps = std::abs(ba.x - bb.x) + std::abs(ba.y - bb.y) + std::abs(ba.z - bb.z);
+          if (steps <= 1) {
+            add(ba);
+            if (steps == 1) add(bb);
+          } else {
+            ForEachBlockOnSegment(a, b, 1.0f, add);
+          }
         }
       }
     }

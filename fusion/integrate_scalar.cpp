@@ -21,10 +21,10 @@ void IntegrateBlockScalar(const FrameView& f, BlockIndex index, TsdfBlock& block
         const float cz_ = ((f.r[6] * px + f.r[7] * py) + f.r[8] * pz) + f.t[2];
         if (!(cz_ > 0.0f)) continue;
         const float inv_z = 1.0f / cz_;
-        const float uf = std::floor((f.fx * cx_) * inv_z + f.cx + 0.5f);
-        const float vf = std::floor((f.fy * cy_) * inv_z + f.cy + 0.5f);
-        if (!(uf >= 0.0f && uf <= float(f.width - 1) && vf >= 0.0f && vf <= float(f.height - 1)))
-          continue;
+        // Nearest pixel: floor(u + 0.5), i.e. truncation once u + 0.5 is known to be >= 0.
+        const float uf = (f.fx * cx_) * inv_z + f.cx + 0.5f;
+        const float vf = (f.fy * cy_) * inv_z + f.cy + 0.5f;
+        if (!(uf >= 0.0f && uf < float(f.width) && vf >= 0.0f && vf < float(f.height))) continue;
         const int pixel = int(vf) * f.width + int(uf);
         const float d = f.depth[pixel];
         if (!(d >= f.min_depth_m && d <= f.max_depth_m)) continue;

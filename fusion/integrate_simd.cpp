@@ -32,7 +32,7 @@ VOXPLAN_AVX2 void IntegrateBlockSimd(const FrameView& f, BlockIndex index, TsdfB
   const __m256 r0 = Splat(f.r[0]), r3 = Splat(f.r[3]), r6 = Splat(f.r[6]);
   const __m256 zero = _mm256_setzero_ps(), one = Splat(1.0f), minus_one = Splat(-1.0f);
   const __m256 half = Splat(0.5f);
-  const __m256 max_u = Splat(float(f.width - 1)), max_v = Splat(float(f.height - 1));
+  const __m256 max_u = Splat(float(f.width)), max_v = Splat(float(f.height));
   const __m256 inv_tsdf_scale = Splat(1.0f / kTsdfScale), inv_w_scale = Splat(1.0f / kWeightScale);
   const __m256i width = _mm256_set1_epi32(f.width);
   const __m256i byte_mask = _mm256_set1_epi32(0xff);
@@ -57,14 +57,14 @@ VOXPLAN_AVX2 void IntegrateBlockSimd(const FrameView& f, BlockIndex index, TsdfB
       __m256 valid = _mm256_cmp_ps(cz_, zero, _CMP_GT_OQ);
       if (_mm256_testz_ps(valid, valid)) continue;
       const __m256 inv_z = _mm256_div_ps(one, cz_);
-      const __m256 uf = _mm256_floor_ps(_mm256_add_ps(
-          _mm256_add_ps(_mm256_mul_ps(_mm256_mul_ps(Splat(f.fx), cx_), inv_z), Splat(f.cx)), half));
-      const __m256 vf = _mm256_floor_ps(_mm256_add_ps(
-          _mm256_add_ps(_mm256_mul_ps(_mm256_mul_ps(Splat(f.fy), cy_), inv_z), Splat(f.cy)), half));
+      const __m256 uf = _mm256_add_ps(
+          _mm256_add_ps(_mm256_mul_ps(_mm256_mul_ps(Splat(f.fx), cx_), inv_z), Splat(f.cx)), half);
+      const __m256 vf = _mm256_add_ps(
+          _mm256_add_ps(_mm256_mul_ps(_mm256_mul_ps(Splat(f.fy), cy_), inv_z), Splat(f.cy)), half);
       valid = _mm256_and_ps(valid, _mm256_cmp_ps(uf, zero, _CMP_GE_OQ));
-      valid = _mm256_and_ps(valid, _mm256_cmp_ps(uf, max_u, _CMP_LE_OQ));
+      valid = _mm256_and_ps(valid, _mm256_cmp_ps(uf, max_u, _CMP_LT_OQ));
       valid = _mm256_and_ps(valid, _mm256_cmp_ps(vf, zero, _CMP_GE_OQ));
-      valid = _mm256_and_ps(valid, _mm256_cmp_ps(vf, max_v, _CMP_LE_OQ));
+      valid = _mm256_and_ps(valid, _mm256_cmp_ps(vf, max_v, _CMP_LT_OQ));
       if (_mm256_testz_ps(valid, valid)) continue;
       // Invalid lanes gather pixel 0 (masked off anyway) so no index is out of range.
       const __m256i pixel =

@@ -68,6 +68,7 @@ McCase BuildCase(int index) {
       out.edges[3 * t + 1] = int8_t(loop[k]);
       out.edges[3 * t + 2] = int8_t(loop[k + 1]);
     }
+    for (int e : loop) out.edge_mask |= uint16_t(1u << e);
   }
   return out;
 }

@@ -17,6 +17,7 @@ inline constexpr int kEdgeAxis[12] = {0, 0, 0, 0, 1, 1, 1, 1, 2, 2, 2, 2};
 
 struct McCase {
   uint8_t num_triangles = 0;
+  uint16_t edge_mask = 0;          // bit e set when edge e carries a vertex
   std::array<int8_t, 36> edges{};  // 3 edge ids per triangle
 };
 

@@ -20,34 +20,65 @@ constexpr int kGridCells = kGrid * kGrid * kGrid;
 // A block and its +1 neighbour layer copied into one dense 9^3 grid, so every cube's corners
 // are plain array reads.
 struct LocalGrid {
+  static constexpr uint8_t kObserved = 1, kInside = 2;
   float tsdf[kGridCells];
-  bool observed[kGridCells];
+  uint8_t flags[kGridCells];  // kObserved | kInside (negative distance)
   uint8_t rgb[kGridCells][3];
+  // Per x-row (index y + 9 z) bit x set when that cell is observed / inside: a cube's 8 signs
+  // are then two bits from each of four rows.
+  uint16_t observed_row[kGrid * kGrid];
+  uint16_t inside_row[kGrid * kGrid];
   static int Index(int x, int y, int z) { return x + kGrid * (y + kGrid * z); }
 };
 
-void FillGrid(const TsdfVolume& volume, BlockIndex b, uint16_t min_weight, LocalGrid& grid) {
-  std::fill(std::begin(grid.observed), std::end(grid.observed), false);
+// Cube corner c (offset (c & 1, (c >> 1) & 1, c >> 2)) as an offset in the grid.
+constexpr int kCornerOffset[8] = {0,
+                                  1,
+                                  kGrid,
+                                  kGrid + 1,
+                                  kGrid* kGrid,
+                                  kGrid* kGrid + 1,
+                                  kGrid* kGrid + kGrid,
+                                  kGrid* kGrid + kGrid + 1};
+
+// Fills the grid; false when no surface can pass through it (no observed voxel inside or
+// none outside), the common case that then costs no cube visits.
+bool FillGrid(const TsdfVolume& volume, BlockIndex b, uint16_t min_weight, LocalGrid& grid) {
+  std::fill(std::begin(grid.flags), std::end(grid.flags), uint8_t(0));
+  bool any_inside = false, any_outside = false;
   for (int n = 0; n < 8; ++n) {
     const int dx = n & 1, dy = (n >> 1) & 1, dz = n >> 2;
     const TsdfBlock* block = volume.FindBlock({b.x + dx, b.y + dy, b.z + dz});
     if (!block) continue;
     // Neighbour (dx,dy,dz) contributes its first voxel layer along each offset axis.
-    const int x0 = dx ? kBlockSide : 0, x1 = dx ? kGrid : kBlockSide;
-    const int y0 = dy ? kBlockSide : 0, y1 = dy ? kGrid : kBlockSide;
-    const int z0 = dz ? kBlockSide : 0, z1 = dz ? kGrid : kBlockSide;
-    for (int z = z0; z < z1; ++z)
-      for (int y = y0; y < y1; ++y)
-        for (int x = x0; x < x1; ++x) {
+    for (int z = dz ? kBlockSide : 0; z < (dz ? kGrid : kBlockSide); ++z)
+      for (int y = dy ? kBlockSide : 0; y < (dy ? kGrid : kBlockSide); ++y)
+        for (int x = dx ? kBlockSide : 0; x < (dx ? kGrid : kBlockSide); ++x) {
           const int src = LinearIndex(x & kBlockMask, y & kBlockMask, z & kBlockMask);
           const int dst = LocalGrid::Index(x, y, z);
-          grid.observed[dst] = block->weight[src] >= min_weight && block->weight[src] > 0;
+          if (block->weight[src] < min_weight || block->weight[src] == 0) continue;
+          const bool inside = block->tsdf[src] < 0;
+          any_inside |= inside;
+          any_outside |= !inside;
+          grid.flags[dst] = LocalGrid::kObserved | (inside ? LocalGrid::kInside : 0);
           grid.tsdf[dst] = DecodeTsdf(block->tsdf[src]);
           grid.rgb[dst][0] = block->r[src];
           grid.rgb[dst][1] = block->g[src];
           grid.rgb[dst][2] = block->b[src];
         }
   }
+  if (!(any_inside && any_outside)) return false;
+  for (int r = 0; r < kGrid * kGrid; ++r) {
+    uint16_t observed = 0, inside = 0;
+    for (int x = 0; x < kGrid; ++x) {
+      const uint8_t f = grid.flags[r * kGrid + x];
+      observed |= uint16_t((f & LocalGrid::kObserved) << x);
+      inside |= uint16_t(((f & LocalGrid::kInside) >> 1) << x);
+    }
+    grid.observed_row[r] = observed;
+    grid.inside_row[r] = inside;
+  }
+  return true;
 }
 
 // An edge is named by its lower voxel (global) and axis: the same key from every block that
@@ -61,53 +92,75 @@ uint64_t EdgeKey(GlobalVoxelIndex g, int axis) {
 }
 
 struct BlockMesh {
-  std::vector<uint64_t> keys;  // one per local vertex
+  std::vector<uint64_t> keys;   // one per local vertex
+  std::vector<uint8_t> shared;  // 1 when a neighbouring block's cubes use the same edge
   std::vector<Eigen::Vector3f> positions;
   std::vector<std::array<uint8_t, 3>> colors;
   std::vector<std::array<uint32_t, 3>> triangles;  // local vertex ids
 };
 
+// Welding within a block: grid edge (cell, axis) -> local vertex id, reset after each block
+// through the list of entries it set.
+struct EdgeVertexMap {
+  std::vector<int32_t> vertex = std::vector<int32_t>(kGridCells * 3, -1);
+  std::vector<int32_t> touched;
+  void Reset() {
+    for (int32_t i : touched) vertex[size_t(i)] = -1;
+    touched.clear();
+  }
+};
+
 void MeshBlock(const TsdfVolume& volume, BlockIndex b, const MeshParams& params, LocalGrid& grid,
-               std::vector<int32_t>& edge_vertex, BlockMesh& out) {
+               EdgeVertexMap& edges, BlockMesh& out) {
   const auto& table = internal::MarchingCubesTable();
   const float s = volume.voxel_size_m();
-  FillGrid(volume, b, uint16_t(std::ceil(params.min_weight * kWeightScale)), grid);
-  std::fill(edge_vertex.begin(), edge_vertex.end(), -1);
+  if (!FillGrid(volume, b, uint16_t(std::ceil(params.min_weight * kWeightScale)), grid)) return;
   const GlobalVoxelIndex origin = GlobalOf(b, {0, 0, 0});
 
   for (int z = 0; z < kBlockSide; ++z)
-    for (int y = 0; y < kBlockSide; ++y)
+    for (int y = 0; y < kBlockSide; ++y) {
+      const int r0 = y + kGrid * z, r1 = r0 + 1, r2 = r0 + kGrid, r3 = r2 + 1;
+      const uint32_t observed = grid.observed_row[r0] & grid.observed_row[r1] &
+                                grid.observed_row[r2] & grid.observed_row[r3];
+      const uint32_t any_inside =
+          grid.inside_row[r0] | grid.inside_row[r1] | grid.inside_row[r2] | grid.inside_row[r3];
+      const uint32_t all_inside =
+          grid.inside_row[r0] & grid.inside_row[r1] & grid.inside_row[r2] & grid.inside_row[r3];
+      if (observed == 0 || any_inside == 0 || all_inside == 0x1ff) continue;  // no surface here
       for (int x = 0; x < kBlockSide; ++x) {
-        int corner_cell[8];
-        int case_index = 0;
-        bool complete = true;
-        for (int c = 0; c < 8; ++c) {
-          corner_cell[c] = LocalGrid::Index(x + (c & 1), y + ((c >> 1) & 1), z + (c >> 2));
-          complete &= grid.observed[corner_cell[c]];
-          if (grid.tsdf[corner_cell[c]] < 0.f) case_index |= 1 << c;
-        }
-        if (!complete || case_index == 0 || case_index == 255) continue;
+        if (((observed >> x) & 3) != 3) continue;
+        const int case_index =
+            int((grid.inside_row[r0] >> x) & 3) | int((grid.inside_row[r1] >> x) & 3) << 2 |
+            int((grid.inside_row[r2] >> x) & 3) << 4 | int((grid.inside_row[r3] >> x) & 3) << 6;
+        if (case_index == 0 || case_index == 255) continue;
+        const int base = LocalGrid::Index(x, y, z);
         const internal::McCase& mc = table[case_index];
         uint32_t vertex_of_edge[12];
         for (int e = 0; e < 12; ++e) {
-          bool used = false;
-          for (int k = 0; k < 3 * mc.num_triangles; ++k) used |= mc.edges[k] == e;
-          if (!used) continue;
+          if (!((mc.edge_mask >> e) & 1)) continue;
           const int c0 = internal::kEdgeCorner[e][0], axis = internal::kEdgeAxis[e];
-          const int lx = x + (c0 & 1), ly = y + ((c0 >> 1) & 1), lz = z + (c0 >> 2);
-          int32_t& slot = edge_vertex[LocalGrid::Index(lx, ly, lz) * 3 + axis];
+          const int a = base + kCornerOffset[c0];
+          int32_t& slot = edges.vertex[size_t(a) * 3 + size_t(axis)];
           if (slot < 0) {
-            const int a = corner_cell[c0], bcell = corner_cell[internal::kEdgeCorner[e][1]];
+            const int bcell = base + kCornerOffset[internal::kEdgeCorner[e][1]];
             const float va = grid.tsdf[a], vb = grid.tsdf[bcell];
             const float t = va / (va - vb);
-            const GlobalVoxelIndex g{origin.x + lx, origin.y + ly, origin.z + lz};
+            const GlobalVoxelIndex g{origin.x + x + (c0 & 1), origin.y + y + ((c0 >> 1) & 1),
+                                     origin.z + z + (c0 >> 2)};
             Eigen::Vector3f p = VoxelCenter(g, s);
             p[axis] += t * s;
             std::array<uint8_t, 3> rgb;
-            for (int k = 0; k < 3; ++k)
-              rgb[k] = uint8_t(std::lround(
-                  float(grid.rgb[a][k]) + t * (float(grid.rgb[bcell][k]) - float(grid.rgb[a][k]))));
+            for (int k = 0; k < 3; ++k)  // t in [0, 1]: +0.5 and truncation round to nearest
+              rgb[k] = uint8_t(float(grid.rgb[a][k]) +
+                               t * (float(grid.rgb[bcell][k]) - float(grid.rgb[a][k])) + 0.5f);
             slot = int32_t(out.positions.size());
+            edges.touched.push_back(a * 3 + axis);
+            // The four cubes around an edge reach into the previous block when a perpendicular
+            // coordinate is 0, and the edge lies in the next block when one is 8.
+            const int l[3] = {x + (c0 & 1), y + ((c0 >> 1) & 1), z + (c0 >> 2)};
+            const int e1 = (axis + 1) % 3, e2 = (axis + 2) % 3;
+            out.shared.push_back(l[e1] == 0 || l[e1] == kBlockSide || l[e2] == 0 ||
+                                 l[e2] == kBlockSide);
             out.keys.push_back(EdgeKey(g, axis));
             out.positions.push_back(p);
             out.colors.push_back(rgb);
@@ -119,6 +172,8 @@ void MeshBlock(const TsdfVolume& volume, BlockIndex b, const MeshParams& params,
                                    vertex_of_edge[mc.edges[3 * k + 1]],
                                    vertex_of_edge[mc.edges[3 * k + 2]]});
       }
+    }
+  edges.Reset();
 }
 
 }  // namespace
@@ -128,34 +183,42 @@ Mesh ExtractMesh(const TsdfVolume& volume, const MeshParams& params) {
   std::vector<BlockMesh> parts(blocks.size());
   ParallelFor(blocks.size(), 8, [&](size_t begin, size_t end) {
     auto grid = std::make_unique<LocalGrid>();
-    std::vector<int32_t> edge_vertex(kGridCells * 3);
+    EdgeVertexMap edges;
     for (size_t i = begin; i < end; ++i)
-      MeshBlock(volume, blocks[i], params, *grid, edge_vertex, parts[i]);
+      MeshBlock(volume, blocks[i], params, *grid, edges, parts[i]);
   });
 
-  // Weld: blocks meet on shared edges, which carry the same key and identical values.
-  size_t total = 0;
+  // Weld: blocks meet on shared edges, which carry the same key and identical values. Only
+  // vertices on block borders can be shared; the first in block order stands for all.
   std::vector<size_t> offset(parts.size() + 1, 0);
   for (size_t i = 0; i < parts.size(); ++i) offset[i + 1] = offset[i] + parts[i].keys.size();
-  total = offset.back();
-  std::vector<std::pair<uint64_t, uint32_t>> order(total);
+  const size_t total = offset.back();
+  std::vector<std::pair<uint64_t, uint32_t>> border;
   for (size_t i = 0; i < parts.size(); ++i)
     for (size_t k = 0; k < parts[i].keys.size(); ++k)
-      order[offset[i] + k] = {parts[i].keys[k], uint32_t(offset[i] + k)};
-  std::sort(order.begin(), order.end());
+      if (parts[i].shared[k]) border.emplace_back(parts[i].keys[k], uint32_t(offset[i] + k));
+  std::sort(border.begin(), border.end());
+  std::vector<uint32_t> canonical(total);
+  for (size_t k = 0; k < total; ++k) canonical[k] = uint32_t(k);
+  for (size_t k = 1; k < border.size(); ++k)
+    if (border[k].first == border[k - 1].first)
+      canonical[border[k].second] = canonical[border[k - 1].second];
 
   Mesh mesh;
+  mesh.positions.reserve(total);
+  if (params.with_color) mesh.colors.reserve(total);
   std::vector<uint32_t> welded(total);
-  for (size_t k = 0; k < total; ++k) {
-    if (k == 0 || order[k].first != order[k - 1].first) {
-      const uint32_t seq = order[k].second;
-      const size_t part =
-          size_t(std::upper_bound(offset.begin(), offset.end(), seq) - offset.begin()) - 1;
-      mesh.positions.push_back(parts[part].positions[seq - offset[part]]);
-      if (params.with_color) mesh.colors.push_back(parts[part].colors[seq - offset[part]]);
+  for (size_t i = 0; i < parts.size(); ++i)
+    for (size_t k = 0; k < parts[i].keys.size(); ++k) {
+      const size_t seq = offset[i] + k;
+      if (canonical[seq] != seq) {
+        welded[seq] = welded[canonical[seq]];
+        continue;
+      }
+      welded[seq] = uint32_t(mesh.positions.size());
+      mesh.positions.push_back(parts[i].positions[k]);
+      if (params.with_color) mesh.colors.push_back(parts[i].colors[k]);
     }
-    welded[order[k].second] = uint32_t(mesh.positions.size() - 1);
-  }
   for (size_t i = 0; i < parts.size(); ++i)
     for (const auto& tri : parts[i].triangles) {
       const std::array<uint32_t, 3> t = {welded[offset[i] + tri[0]], welded[offset[i] + tri[1]],

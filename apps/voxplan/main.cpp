@@ -19,7 +19,7 @@ int main(int argc, char** argv) {
   });
 
   std::vector<Command> commands = {AddFuseCommand(app), AddMeshCommand(app), AddInfoCommand(app),
-                                   AddEvalCommand(app), AddDemoCommand(app)};
+                                   AddEvalCommand(app), AddDemoCommand(app), AddRenderCommand(app)};
   try {
     app.parse(argc, argv);
   } catch (const CLI::CallForHelp& e) {

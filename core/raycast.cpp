@@ -1,0 +1,580 @@
+#include "core/raycast.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <vector>
+
+#include "core/parallel.h"
+
+namespace voxplan {
+namespace {
+
+constexpr int kRangeCell = 8;  // pixels per side of a range-image cell
+constexpr int kTile = 16;      // pixels per side of one parallel work item
+constexpr int kLanes = 4;      // rays a worker marches interleaved
+// Step as a fraction of the stored distance: the nearest voxel's centre can be up to 0.87 voxel
+// from the sample, and the negative band behind a surface is what catches an overshoot.
+constexpr float kStepScale = 0.9f;
+constexpr int kNewtonIterations = 3;
+constexpr float kConvergedVoxels = 0.05f;   // a Newton step this small ends the search
+constexpr float kMinSlopeFraction = 0.05f;  // of the head-on slope; below it, the ray grazes
+constexpr int kSecantIterations = 3;
+constexpr int kMaxBracketShifts = 2;  // voxels the trilinear bracket may move either way
+constexpr float kNaN = std::numeric_limits<float>::quiet_NaN();
+
+// Per cell of kRangeCell^2 pixels, the depth range where the rays through it can meet an
+// allocated block: rays skip everything in front of the nearest block at once.
+struct RangeImage {
+  int cols = 0, rows = 0;
+  std::vector<float> z_min, z_max;  // z_min > z_max where no block projects
+};
+
+struct Chunk {
+  std::vector<float> z_min, z_max;
+};
+
+// The depth where marching starts: a voxel before min_depth, so that a surface just beyond it
+// is approached from its positive side (crossings in front of min_depth are not reported).
+float MarchStart(const TsdfVolume& volume, const RaycastParams& params) {
+  return std::max(params.min_depth_m - volume.voxel_size_m(), 1e-3f);
+}
+
+RangeImage BuildRangeImage(const TsdfVolume& volume, const PinholeCamera& camera,
+                           const Pose3f& T_C_W, const RaycastParams& params) {
+  RangeImage range;
+  range.cols = (camera.width + kRangeCell - 1) / kRangeCell;
+  range.rows = (camera.height + kRangeCell - 1) / kRangeCell;
+  const size_t num_cells = size_t(range.cols) * size_t(range.rows);
+  constexpr float kInf = std::numeric_limits<float>::infinity();
+
+  std::vector<BlockIndex> blocks;
+  blocks.reserve(volume.num_blocks());
+  volume.ForEachBlock([&](BlockIndex b, const TsdfBlock&) { blocks.push_back(b); });
+
+  // Min and max are order-independent, so the chunking (and the thread count) cannot change
+  // the result; each chunk owns its partial image, so nothing is shared while splatting.
+  constexpr size_t kBlocksPerChunk = 1024;
+  const size_t num_chunks = std::clamp<size_t>(blocks.size() / kBlocksPerChunk, 1, 16);
+  std::vector<Chunk> chunks(num_chunks);
+  const float block_m = volume.block_size_m();
+  const Eigen::Matrix3f R_C_W = T_C_W.linear();
+  const Eigen::Vector3f axis_x = R_C_W.col(0) * block_m, axis_y = R_C_W.col(1) * block_m,
+                        axis_z = R_C_W.col(2) * block_m;
+  const float z_near = MarchStart(volume, params), z_far = params.max_depth_m;
+  // Pixels are admitted half a pixel beyond the projected box to absorb rounding.
+  constexpr float kPixelMargin = 0.5f;
+
+  ParallelFor(num_chunks, 1, [&](size_t begin, size_t end) {
+    for (size_t c = begin; c < end; ++c) {
+      Chunk& chunk = chunks[c];
+      chunk.z_min.assign(num_cells, kInf);
+      chunk.z_max.assign(num_cells, -kInf);
+      const size_t first = blocks.size() * c / num_chunks;
+      const size_t last = blocks.size() * (c + 1) / num_chunks;
+      for (size_t k = first; k < last; ++k) {
+        const Eigen::Vector3f p0_C = T_C_W * BlockOrigin(blocks[k], block_m);
+        Eigen::Vector3f corner_C[8];
+        float box_z_min = kInf, box_z_max = -kInf;
+        for (int i = 0; i < 8; ++i) {
+          corner_C[i] = p0_C;
+          if (i & 1) corner_C[i] += axis_x;
+          if (i & 2) corner_C[i] += axis_y;
+          if (i & 4) corner_C[i] += axis_z;
+          box_z_min = std::min(box_z_min, corner_C[i].z());
+          box_z_max = std::max(box_z_max, corner_C[i].z());
+        }
+        if (box_z_max < z_near || box_z_min > z_far) continue;
+        // The box clipped to z >= z_near: its corners in front plus the edges' crossings.
+        float u_min = kInf, u_max = -kInf, v_min = kInf, v_max = -kInf;
+        auto add = [&](const Eigen::Vector3f& p) {
+          const float u = camera.fx * p.x() / p.z() + camera.cx;
+          const float v = camera.fy * p.y() / p.z() + camera.cy;
+          u_min = std::min(u_min, u), u_max = std::max(u_max, u);
+          v_min = std::min(v_min, v), v_max = std::max(v_max, v);
+        };
+        for (int i = 0; i < 8; ++i) {
+          if (corner_C[i].z() >= z_near) add(corner_C[i]);
+          if (box_z_min >= z_near) continue;
+          for (int bit = 1; bit < 8; bit <<= 1) {
+            if (i & bit) continue;
+            const Eigen::Vector3f& a = corner_C[i];
+            const Eigen::Vector3f& b = corner_C[i | bit];
+            if ((a.z() < z_near) == (b.z() < z_near)) continue;
+            const float t = (z_near - a.z()) / (b.z() - a.z());
+            Eigen::Vector3f p = a + t * (b - a);
+            p.z() = z_near;
+            add(p);
+          }
+        }
+        if (!(u_min <= u_max) || !(v_min <= v_max)) continue;
+        const float u_lo = std::max(std::ceil(u_min - kPixelMargin), 0.f);
+        const float u_hi = std::min(std::floor(u_max + kPixelMargin), float(camera.width - 1));
+        const float v_lo = std::max(std::ceil(v_min - kPixelMargin), 0.f);
+        const float v_hi = std::min(std::floor(v_max + kPixelMargin), float(camera.height - 1));
+        if (u_lo > u_hi || v_lo > v_hi) continue;
+        const float z_lo = std::max(box_z_min, z_near), z_hi = box_z_max;
+        for (int cy = int(v_lo) / kRangeCell; cy <= int(v_hi) / kRangeCell; ++cy)
+          for (int cx = int(u_lo) / kRangeCell; cx <= int(u_hi) / kRangeCell; ++cx) {
+            const size_t cell = size_t(cy) * size_t(range.cols) + size_t(cx);
+            chunk.z_min[cell] = std::min(chunk.z_min[cell], z_lo);
+            chunk.z_max[cell] = std::max(chunk.z_max[cell], z_hi);
+          }
+      }
+    }
+  });
+
+  range.z_min.assign(num_cells, kInf);
+  range.z_max.assign(num_cells, -kInf);
+  for (const Chunk& chunk : chunks)
+    for (size_t i = 0; i < num_cells; ++i) {
+      range.z_min[i] = std::min(range.z_min[i], chunk.z_min[i]);
+      range.z_max[i] = std::max(range.z_max[i], chunk.z_max[i]);
+    }
+  return range;
+}
+
+// floor() for coordinates far inside the int range; std::floor is a slow sequence without SSE4.1.
+inline int32_t FloorToInt(float x) {
+  const int32_t i = int32_t(x);
+  return i - int32_t(float(i) > x);
+}
+
+// The 2x2x2 voxel centres around a point, for trilinear interpolation of TSDF, colour and the
+// gradient. Corner k is offset (k & 1, (k >> 1) & 1, k >> 2).
+struct Cell {
+  GlobalVoxelIndex base;
+  bool loaded = false;   // tsdf/block/index hold the corners of `base`
+  uint8_t observed = 0;  // bit k: corner k observed
+  float tsdf[8];         // normalised by the truncation distance
+  const TsdfBlock* block[8];
+  int index[8];
+  Eigen::Vector3f frac;  // position inside the cell, each in [0, 1)
+
+  bool complete() const { return observed == 0xff; }
+  float Tsdf() const {
+    const float fx = frac.x(), fy = frac.y(), fz = frac.z();
+    const float x00 = tsdf[0] + fx * (tsdf[1] - tsdf[0]);
+    const float x10 = tsdf[2] + fx * (tsdf[3] - tsdf[2]);
+    const float x01 = tsdf[4] + fx * (tsdf[5] - tsdf[4]);
+    const float x11 = tsdf[6] + fx * (tsdf[7] - tsdf[6]);
+    const float y0 = x00 + fy * (x10 - x00), y1 = x01 + fy * (x11 - x01);
+    return y0 + fz * (y1 - y0);
+  }
+  // Gradient of the trilinear interpolant, normalised TSDF per voxel.
+  Eigen::Vector3f Gradient() const {
+    const float* t = tsdf;
+    const float fx = frac.x(), fy = frac.y(), fz = frac.z();
+    return {(1 - fy) * (1 - fz) * (t[1] - t[0]) + fy * (1 - fz) * (t[3] - t[2]) +
+                (1 - fy) * fz * (t[5] - t[4]) + fy * fz * (t[7] - t[6]),
+            (1 - fx) * (1 - fz) * (t[2] - t[0]) + fx * (1 - fz) * (t[3] - t[1]) +
+                (1 - fx) * fz * (t[6] - t[4]) + fx * fz * (t[7] - t[5]),
+            (1 - fx) * (1 - fy) * (t[4] - t[0]) + fx * (1 - fy) * (t[5] - t[1]) +
+                (1 - fx) * fy * (t[6] - t[2]) + fx * fy * (t[7] - t[3])};
+  }
+};
+
+// Block lookups for one worker: the last block, then a small direct-mapped cache (misses
+// included) in front of the hash map, since neighbouring rays visit the same blocks.
+class BlockCache {
+ public:
+  explicit BlockCache(const TsdfVolume& volume) : volume_(volume) {}
+
+  const TsdfBlock* Find(BlockIndex b) {
+    if (b == last_index_ && last_valid_) return last_block_;
+    last_index_ = b;
+    last_valid_ = true;
+    if (!InPackRange(b)) return last_block_ = nullptr;
+    const uint64_t key = PackBlockIndex(b);
+    Entry& e = entries_[(key * 0x9e3779b97f4a7c15ull) >> (64 - kCacheBits)];
+    if (e.key != key) {
+      e.key = key;
+      e.block = volume_.FindBlock(b);
+    }
+    return last_block_ = e.block;
+  }
+
+ private:
+  static constexpr int kCacheBits = 8;
+  struct Entry {
+    uint64_t key = ~0ull;  // never a packed index (those use 63 bits)
+    const TsdfBlock* block = nullptr;
+  };
+  const TsdfVolume& volume_;
+  Entry entries_[1 << kCacheBits];
+  BlockIndex last_index_{};
+  const TsdfBlock* last_block_ = nullptr;
+  bool last_valid_ = false;
+};
+
+class Sampler {
+ public:
+  Sampler(const TsdfVolume& volume, const RaycastParams& params)
+      : cache_(volume),
+        voxel_m_(volume.voxel_size_m()),
+        inv_voxel_(1.f / volume.voxel_size_m()),
+        trunc_m_(volume.trunc_m()),
+        // DecodeWeight(w) = w / 128 exactly, so w >= ceil(min_weight * 128) is the same test.
+        min_weight_fixed_(
+            uint32_t(std::clamp(std::ceil(params.min_weight * kWeightScale), 1.f, 65536.f))) {}
+
+  const TsdfBlock* Find(BlockIndex b) { return cache_.Find(b); }
+  bool Observed(const TsdfBlock& block, int i) const {
+    return uint32_t(block.weight[i]) >= min_weight_fixed_;
+  }
+
+  // Points `cell` at p_W, reading the corners only when p_W left the cell it held. Unobserved
+  // corners take the interpolation-weighted mean of the observed ones; returns whether all
+  // eight were observed.
+  bool Gather(const Eigen::Vector3f& p_W, Cell* cell) {
+    const Eigen::Vector3f q = p_W * inv_voxel_ - Eigen::Vector3f::Constant(0.5f);
+    const GlobalVoxelIndex base{FloorToInt(q.x()), FloorToInt(q.y()), FloorToInt(q.z())};
+    cell->frac = q - Eigen::Vector3f(float(base.x), float(base.y), float(base.z));
+    if (cell->loaded && cell->base == base) return cell->complete();
+    cell->base = base;
+    cell->loaded = true;
+    cell->observed = 0;
+    const VoxelIndex local = LocalOf(base);
+    if (local.x < kBlockMask && local.y < kBlockMask && local.z < kBlockMask) {
+      // The common case: all eight corners in one block.
+      const TsdfBlock* block = Find(BlockOf(base));
+      const int i0 = LinearIndex(local);
+      for (int k = 0; k < 8; ++k) {
+        const int i =
+            i0 + (k & 1) + ((k >> 1) & 1) * kBlockSide + (k >> 2) * kBlockSide * kBlockSide;
+        Load(block, i, k, cell);
+      }
+    } else {
+      for (int k = 0; k < 8; ++k) {
+        const GlobalVoxelIndex g{base.x + (k & 1), base.y + ((k >> 1) & 1), base.z + (k >> 2)};
+        Load(Find(BlockOf(g)), LinearIndex(LocalOf(g)), k, cell);
+      }
+    }
+    if (cell->complete()) return true;
+    float sum = 0.f, sum_w = 0.f;
+    for (int k = 0; k < 8; ++k)
+      if (cell->observed & (1 << k)) sum += cell->tsdf[k], sum_w += 1.f;
+    const float fill = sum_w > 0.f ? sum / sum_w : 1.f;
+    for (int k = 0; k < 8; ++k)
+      if (!(cell->observed & (1 << k))) cell->tsdf[k] = fill;
+    return false;
+  }
+
+  float voxel_m() const { return voxel_m_; }
+  float inv_voxel() const { return inv_voxel_; }
+  float trunc_m() const { return trunc_m_; }
+
+ private:
+  void Load(const TsdfBlock* block, int i, int k, Cell* cell) const {
+    cell->block[k] = block;
+    cell->index[k] = i;
+    if (block && Observed(*block, i)) {
+      cell->tsdf[k] = DecodeTsdf(block->tsdf[i]);
+      cell->observed |= uint8_t(1 << k);
+    }
+  }
+
+  BlockCache cache_;
+  float voxel_m_, inv_voxel_, trunc_m_;
+  uint32_t min_weight_fixed_;
+};
+
+struct RayResult {
+  RayStatus status = RayStatus::kUnobserved;
+  float z = 0.f;
+  Eigen::Vector3f normal_W = Eigen::Vector3f::Constant(kNaN);
+  uint32_t color = 0;
+};
+
+// Trilinear colour over the observed corners.
+uint32_t CellColor(const Cell& cell) {
+  const float fx = cell.frac.x(), fy = cell.frac.y(), fz = cell.frac.z();
+  float r = 0.f, g = 0.f, b = 0.f, sum_w = 0.f;
+  for (int k = 0; k < 8; ++k) {
+    if (!(cell.observed & (1 << k))) continue;
+    const float w =
+        ((k & 1) ? fx : 1 - fx) * (((k >> 1) & 1) ? fy : 1 - fy) * ((k >> 2) ? fz : 1 - fz);
+    const TsdfBlock& block = *cell.block[k];
+    const int i = cell.index[k];
+    r += w * float(block.r[i]);
+    g += w * float(block.g[i]);
+    b += w * float(block.b[i]);
+    sum_w += w;
+  }
+  if (!(sum_w > 0.f)) return 0;
+  const float inv = 1.f / sum_w;
+  auto to8 = [inv](float c) { return uint8_t(std::clamp(c * inv + 0.5f, 0.f, 255.f)); };
+  return PackRgb(to8(r), to8(g), to8(b));
+}
+
+// One ray's march, advanced a sample at a time so that a worker can interleave several rays
+// and overlap their memory latency. The ray is p(z) = origin + z * dir_W, with dir_W the
+// camera ray scaled to unit optical depth, so z is the depth itself.
+struct Ray {
+  Eigen::Vector3f dir_W, inv_dir;
+  float z = 0.f, z_end = 0.f;
+  float voxel_z = 0.f;       // one voxel along the ray, in depth units
+  float step_scale_z = 0.f;  // stored fixed-point TSDF to a step in depth units
+  bool have_prev = false;    // previous sample observed, nothing unobserved since
+  float prev_z = 0.f;
+  int16_t prev_tsdf = 0;
+  size_t pixel = 0;
+  RayResult result;
+};
+
+class RayCaster {
+ public:
+  RayCaster(const TsdfVolume& volume, const RaycastParams& params, const Eigen::Vector3f& origin_W)
+      : sampler_(volume, params), params_(params), origin_W_(origin_W) {}
+
+  void Start(const Eigen::Vector3f& dir_W, float z_begin, float z_end, Ray* ray) const {
+    const float dir_norm = dir_W.norm();
+    ray->dir_W = dir_W;
+    constexpr float kFar = 1e30f;  // 1 / 0 without infinities (0 * inf would be NaN)
+    ray->inv_dir = Eigen::Vector3f(dir_W.x() != 0.f ? 1.f / dir_W.x() : kFar,
+                                   dir_W.y() != 0.f ? 1.f / dir_W.y() : kFar,
+                                   dir_W.z() != 0.f ? 1.f / dir_W.z() : kFar);
+    ray->z = z_begin;
+    ray->z_end = z_end;
+    ray->voxel_z = sampler_.voxel_m() / dir_norm;
+    ray->step_scale_z = kStepScale * sampler_.trunc_m() / (kTsdfScale * dir_norm);
+    ray->have_prev = false;
+    ray->result = RayResult{};
+  }
+
+  // Takes one sample; true when the ray is finished and ray->result final.
+  bool Step(Ray& ray) {
+    if (!(ray.z <= ray.z_end)) return true;
+    const float inv_s = sampler_.inv_voxel();
+    const Eigen::Vector3f p = origin_W_ + ray.z * ray.dir_W;
+    const GlobalVoxelIndex g{FloorToInt(p.x() * inv_s), FloorToInt(p.y() * inv_s),
+                             FloorToInt(p.z() * inv_s)};
+    const BlockIndex b = BlockOf(g);
+    const TsdfBlock* block = sampler_.Find(b);
+    if (!block) {
+      // Jump to where the ray leaves this unallocated block (nudged past the face).
+      const float block_m = sampler_.voxel_m() * kBlockSide;
+      float z_exit = std::numeric_limits<float>::infinity();
+      for (int a = 0; a < 3; ++a) {
+        const int32_t face = (&b.x)[a] + (ray.dir_W[a] >= 0.f ? 1 : 0);
+        z_exit = std::min(z_exit, (float(face) * block_m - origin_W_[a]) * ray.inv_dir[a]);
+      }
+      ray.z = std::max(z_exit, ray.z) + 0.01f * ray.voxel_z;
+      ray.have_prev = false;
+      return false;
+    }
+    const int i = LinearIndex(LocalOf(g));
+    if (!sampler_.Observed(*block, i)) {
+      ray.z += ray.voxel_z;
+      ray.have_prev = false;
+      return false;
+    }
+    ray.result.status = RayStatus::kFree;  // at least: an observed voxel was met
+    const int16_t tsdf = block->tsdf[i];
+    if (ray.have_prev && (ray.prev_tsdf >= 0) != (tsdf >= 0)) {
+      if (tsdf >= 0) return true;  // back face: entered from behind a surface
+      if (Refine(ray.dir_W, ray.prev_z, ray.z, DecodeTsdf(ray.prev_tsdf), DecodeTsdf(tsdf),
+                 ray.voxel_z, &ray.result)) {
+        if (ray.result.z < params_.min_depth_m || ray.result.z > params_.max_depth_m) {
+          ray.result = RayResult{};
+          ray.result.status = RayStatus::kFree;
+        }
+        return true;
+      }
+      // The nearest values disagree with the interpolant (noise): keep marching.
+    }
+    ray.have_prev = true;
+    ray.prev_z = ray.z;
+    ray.prev_tsdf = tsdf;
+    ray.z += std::max(float(tsdf) * ray.step_scale_z, ray.voxel_z);
+    return false;
+  }
+
+ private:
+  bool Sample(const Eigen::Vector3f& dir_W, float z, Cell* cell, float* tsdf) {
+    const bool complete = sampler_.Gather(origin_W_ + z * dir_W, cell);
+    *tsdf = cell->Tsdf();
+    return complete;
+  }
+
+  // The nearest voxels changed sign between z_a (value nearest_a >= 0) and z_b (nearest_b < 0).
+  // Finds the zero of the trilinear interpolant: Newton steps from the linear guess (the cell
+  // gradient comes with the values, and the second step usually reuses the cell), else a
+  // bracket moved until it straddles a zero and narrowed by regula falsi. Returns false when
+  // the interpolant has no zero here.
+  bool Refine(const Eigen::Vector3f& dir_W, float z_a, float z_b, float nearest_a, float nearest_b,
+              float voxel_z, RayResult* result) {
+    Cell cell;
+    const float z_guess = z_a + (z_b - z_a) * nearest_a / (nearest_a - nearest_b);
+    // The slope of the normalised TSDF along the ray must be clearly negative: a head-on ray
+    // sees -voxel/trunc per voxel, a grazing one almost nothing.
+    const float max_slope = -kMinSlopeFraction * sampler_.voxel_m() / sampler_.trunc_m();
+    const float dq_dz = sampler_.inv_voxel();  // voxel-grid units per metre of z
+    float z = z_guess;
+    Eigen::Vector3f gradient;
+    bool converged = false;
+    for (int k = 0; k < kNewtonIterations; ++k) {
+      float f = 0.f;
+      if (!Sample(dir_W, z, &cell, &f)) break;
+      gradient = cell.Gradient();
+      const float slope = gradient.dot(dir_W) * dq_dz;  // per metre of z
+      if (!(slope * voxel_z < max_slope)) break;
+      const float dz = -f / slope;
+      if (!(z + dz > z_a - voxel_z && z + dz < z_b + voxel_z)) break;
+      // The last step is not re-sampled: the gradient and colour barely change over it.
+      z += dz;
+      if (std::abs(dz) < kConvergedVoxels * voxel_z) {
+        converged = true;
+        break;
+      }
+    }
+    if (!converged) {
+      if (!Bracket(dir_W, z_a, z_b, voxel_z, &cell, &z)) {
+        if (cell.loaded && cell.complete()) return false;
+        // Unobserved corners around the crossing: the nearest values are all there is.
+        z = z_guess;
+      }
+      float f = 0.f;
+      Sample(dir_W, z, &cell, &f);  // the cell at the final point
+      gradient = cell.Gradient();
+    }
+    result->status = RayStatus::kHit;
+    result->z = z;
+    const float norm = gradient.norm();
+    result->normal_W =
+        norm > 0.f ? Eigen::Vector3f(gradient / norm) : Eigen::Vector3f(kNaN, kNaN, kNaN);
+    result->color = CellColor(cell);
+    return true;
+  }
+
+  // Regula falsi on the trilinear interpolant. False when a cell is incomplete (`cell` then
+  // holds it) or no zero is bracketed within kMaxBracketShifts voxels.
+  bool Bracket(const Eigen::Vector3f& dir_W, float z_a, float z_b, float voxel_z, Cell* cell,
+               float* z_out) {
+    float f_a = 0.f, f_b = 0.f;
+    if (!Sample(dir_W, z_a, cell, &f_a) || !Sample(dir_W, z_b, cell, &f_b)) return false;
+    for (int k = 0; f_a < 0.f && k < kMaxBracketShifts; ++k) {
+      z_b = z_a, f_b = f_a;
+      z_a -= voxel_z;
+      if (!Sample(dir_W, z_a, cell, &f_a)) return false;
+    }
+    for (int k = 0; f_b >= 0.f && k < kMaxBracketShifts; ++k) {
+      z_a = z_b, f_a = f_b;
+      z_b += voxel_z;
+      if (!Sample(dir_W, z_b, cell, &f_b)) return false;
+    }
+    if (!(f_a >= 0.f && f_b < 0.f)) return false;
+    for (int k = 0; k < kSecantIterations; ++k) {
+      const float z = z_a + (z_b - z_a) * f_a / (f_a - f_b);
+      float f = 0.f;
+      if (!Sample(dir_W, z, cell, &f)) break;
+      if (f >= 0.f)
+        z_a = z, f_a = f;
+      else
+        z_b = z, f_b = f;
+    }
+    *z_out = z_a + (z_b - z_a) * f_a / (f_a - f_b);
+    return true;
+  }
+
+  Sampler sampler_;
+  RaycastParams params_;
+  Eigen::Vector3f origin_W_;
+};
+
+}  // namespace
+
+void Raycast(const TsdfVolume& volume, const PinholeCamera& camera, const Pose3f& T_W_C,
+             const RaycastParams& params, RaycastImages& images) {
+  if (!camera.Valid()) {
+    images = RaycastImages{};
+    return;
+  }
+  const int w = camera.width, h = camera.height;
+  auto fit = [w, h](auto& image, auto fill) {
+    if (image.width != w || image.height != h) image = std::decay_t<decltype(image)>(w, h, fill);
+  };
+  const Eigen::Vector3f nan3(kNaN, kNaN, kNaN);
+  fit(images.depth, 0.f);
+  fit(images.vertex_W, nan3);
+  fit(images.normal_W, nan3);
+  fit(images.color, uint32_t{0});
+  fit(images.status, uint8_t(RayStatus::kUnobserved));
+
+  const bool usable = T_W_C.matrix().allFinite() && params.min_depth_m <= params.max_depth_m &&
+                      std::isfinite(params.min_depth_m) && std::isfinite(params.max_depth_m) &&
+                      volume.num_blocks() > 0;
+  const RangeImage range =
+      usable ? BuildRangeImage(volume, camera, T_W_C.inverse(), params) : RangeImage{};
+  const float z_start = MarchStart(volume, params);
+  const Eigen::Matrix3f R_W_C = T_W_C.linear();
+  const Eigen::Vector3f origin_W = T_W_C.translation();
+  const int tiles_x = (w + kTile - 1) / kTile, tiles_y = (h + kTile - 1) / kTile;
+
+  auto write = [&](size_t px, const RayResult& ray, const Eigen::Vector3f& dir_W) {
+    images.status.data[px] = uint8_t(ray.status);
+    if (ray.status == RayStatus::kHit) {
+      images.depth.data[px] = ray.z;
+      images.vertex_W.data[px] = origin_W + ray.z * dir_W;
+      images.normal_W.data[px] = ray.normal_W;
+      images.color.data[px] = ray.color;
+    } else {
+      images.depth.data[px] = 0.f;
+      images.vertex_W.data[px] = nan3;
+      images.normal_W.data[px] = nan3;
+      images.color.data[px] = 0;
+    }
+  };
+
+  ParallelFor(size_t(tiles_x) * size_t(tiles_y), 4, [&](size_t begin, size_t end) {
+    RayCaster caster(volume, params, origin_W);
+    for (size_t tile = begin; tile < end; ++tile) {
+      const int u0 = int(tile % size_t(tiles_x)) * kTile, v0 = int(tile / size_t(tiles_x)) * kTile;
+      const int tile_w = std::min(kTile, w - u0), tile_h = std::min(kTile, h - v0);
+      const int tile_pixels = tile_w * tile_h;
+      int next = 0;
+      // Starts the tile's next ray that has a range to march; false when none is left.
+      auto start_next = [&](Ray* ray) {
+        while (next < tile_pixels) {
+          const int u = u0 + next % tile_w, v = v0 + next / tile_w;
+          ++next;
+          const size_t px = size_t(v) * size_t(w) + size_t(u);
+          if (usable) {
+            const size_t cell =
+                size_t(v / kRangeCell) * size_t(range.cols) + size_t(u / kRangeCell);
+            const float z_begin = std::max(range.z_min[cell], z_start);
+            const float z_end = std::min(range.z_max[cell], params.max_depth_m);
+            if (z_begin <= z_end) {
+              const Eigen::Vector3f dir_C((float(u) - camera.cx) / camera.fx,
+                                          (float(v) - camera.cy) / camera.fy, 1.f);
+              caster.Start(R_W_C * dir_C, z_begin, z_end, ray);
+              ray->pixel = px;
+              return true;
+            }
+          }
+          write(px, RayResult{}, Eigen::Vector3f::Zero());
+        }
+        return false;
+      };
+      Ray rays[kLanes];
+      bool live[kLanes];
+      int num_live = 0;
+      for (int l = 0; l < kLanes; ++l) num_live += (live[l] = start_next(&rays[l]));
+      while (num_live > 0)
+        for (int l = 0; l < kLanes; ++l) {
+          if (!live[l] || !caster.Step(rays[l])) continue;
+          write(rays[l].pixel, rays[l].result, rays[l].dir_W);
+          if (!start_next(&rays[l])) live[l] = false, --num_live;
+        }
+    }
+  });
+}
+
+RaycastImages Raycast(const TsdfVolume& volume, const PinholeCamera& camera, const Pose3f& T_W_C,
+                      const RaycastParams& params) {
+  RaycastImages images;
+  Raycast(volume, camera, T_W_C, params, images);
+  return images;
+}
+
+}  // namespace voxplan

@@ -1,0 +1,378 @@
+// Raycasting against volumes filled with exact analytic signed distances: depth, normals,
+// colour and status per pixel, negative fy, unobserved gaps, depth limits and thread parity.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <cstring>
+#include <functional>
+#include <vector>
+
+#include "core/parallel.h"
+#include "core/raycast.h"
+#include "tests/support/test_support.h"
+
+namespace voxplan {
+namespace {
+
+using test::Box;
+using test::LookAt;
+using test::Plane;
+using test::Sphere;
+using test::TestCamera;
+
+constexpr float kVoxel = 0.01f;
+constexpr float kTrunc = 4 * kVoxel;
+constexpr uint8_t kR = 10, kG = 20, kB = 30;
+
+using Sdf = std::function<float(const Eigen::Vector3f&)>;
+
+// Every block of [lo, hi] within the band (or all of them with `all_blocks`) gets the exact
+// truncated SDF at its voxel centres, weight 1 and a constant colour.
+TsdfVolume FillExact(const Sdf& sdf, const Eigen::Vector3f& lo, const Eigen::Vector3f& hi,
+                     bool all_blocks = false) {
+  TsdfVolume volume({kVoxel, kTrunc});
+  const float block = kVoxel * kBlockSide;
+  const BlockIndex b0 = BlockAt(lo, block), b1 = BlockAt(hi, block);
+  for (int z = b0.z; z <= b1.z; ++z)
+    for (int y = b0.y; y <= b1.y; ++y)
+      for (int x = b0.x; x <= b1.x; ++x) {
+        const BlockIndex b{x, y, z};
+        const Eigen::Vector3f centre = BlockOrigin(b, block) + Eigen::Vector3f::Constant(block / 2);
+        if (!all_blocks && std::abs(sdf(centre)) > block + kTrunc) continue;
+        TsdfBlock& data = volume.FindOrAllocate(b);
+        for (int i = 0; i < kBlockVoxels; ++i) {
+          data.tsdf[i] =
+              EncodeTsdf(sdf(VoxelCenter(GlobalOf(b, VoxelOfLinear(i)), kVoxel)) / kTrunc);
+          data.weight[i] = EncodeWeight(1.0f);
+          data.r[i] = kR, data.g[i] = kG, data.b[i] = kB;
+        }
+      }
+  return volume;
+}
+
+// True when every pixel within `radius` has an analytic hit: away from silhouettes.
+bool Interior(const DepthImage& truth, int u, int v, int radius) {
+  for (int dv = -radius; dv <= radius; ++dv)
+    for (int du = -radius; du <= radius; ++du) {
+      const int uu = u + du, vv = v + dv;
+      if (uu < 0 || vv < 0 || uu >= truth.width || vv >= truth.height) return false;
+      if (truth.at(uu, vv) <= 0.f) return false;
+    }
+  return true;
+}
+
+float Median(std::vector<float> v) {
+  if (v.empty()) return 0.f;
+  std::nth_element(v.begin(), v.begin() + v.size() / 2, v.end());
+  return v[v.size() / 2];
+}
+
+size_t Count(const RaycastImages& images, RayStatus status) {
+  return size_t(std::count(images.status.data.begin(), images.status.data.end(), uint8_t(status)));
+}
+
+// Depth against the analytic depth (in voxels) and normals against the analytic normals,
+// away from silhouettes.
+struct Errors {
+  float median_vox = 0.f, max_vox = 0.f, max_normal_deg = 0.f;
+  size_t checked = 0, missed = 0;
+};
+Errors Compare(const RaycastImages& images, const DepthImage& truth, const PinholeCamera& cam,
+               const Pose3f& T_W_C,
+               const std::function<Eigen::Vector3f(const Eigen::Vector3f&)>& normal_at) {
+  Errors e;
+  std::vector<float> errors;
+  for (int v = 0; v < cam.height; ++v)
+    for (int u = 0; u < cam.width; ++u) {
+      if (!Interior(truth, u, v, 2)) continue;
+      ++e.checked;
+      if (images.status.at(u, v) != uint8_t(RayStatus::kHit)) {
+        ++e.missed;
+        continue;
+      }
+      const float err = std::abs(images.depth.at(u, v) - truth.at(u, v)) / kVoxel;
+      errors.push_back(err);
+      e.max_vox = std::max(e.max_vox, err);
+      const Eigen::Vector3f p_W = T_W_C * cam.Unproject(float(u), float(v), truth.at(u, v));
+      const float cos_angle = images.normal_W.at(u, v).dot(normal_at(p_W));
+      e.max_normal_deg =
+          std::max(e.max_normal_deg, float(std::acos(std::min(1.f, cos_angle)) * 180.0 / M_PI));
+    }
+  e.median_vox = Median(errors);
+  return e;
+}
+
+// Named tolerances: trilinear interpolation of an exact SDF sampled at 1 cm.
+constexpr float kMedianDepthVox = 0.05f;
+constexpr float kMaxDepthVox = 0.2f;
+constexpr float kMaxNormalDeg = 3.0f;
+
+TEST(Raycast, SphereDepthNormalsColourAndVertices) {
+  const Sphere sphere{Eigen::Vector3f(0.02f, -0.03f, 0.01f), 0.3f};
+  const TsdfVolume volume = FillExact([&](const Eigen::Vector3f& p) { return sphere.Sdf(p); },
+                                      sphere.c - Eigen::Vector3f::Constant(0.45f),
+                                      sphere.c + Eigen::Vector3f::Constant(0.45f));
+  const PinholeCamera cam = TestCamera(160, 120);
+  const Pose3f T_W_C = LookAt(sphere.c + Eigen::Vector3f(0.9f, -0.5f, 0.3f), sphere.c);
+  const RaycastImages images = Raycast(volume, cam, T_W_C);
+  ASSERT_EQ(images.depth.width, cam.width);
+  ASSERT_EQ(images.status.height, cam.height);
+
+  const DepthImage truth = test::RenderDepth(sphere, cam, T_W_C);
+  const Errors e = Compare(images, truth, cam, T_W_C, [&](const Eigen::Vector3f& p) {
+    return Eigen::Vector3f((p - sphere.c).normalized());
+  });
+  std::printf("sphere: depth error median %.4f max %.4f voxel, normals max %.3f deg, %zu px\n",
+              e.median_vox, e.max_vox, e.max_normal_deg, e.checked);
+  ASSERT_GT(e.checked, 3000u);
+  EXPECT_EQ(e.missed, 0u);
+  EXPECT_LE(e.median_vox, kMedianDepthVox);
+  EXPECT_LE(e.max_vox, kMaxDepthVox);
+  EXPECT_LE(e.max_normal_deg, kMaxNormalDeg);
+
+  size_t hits = 0;
+  for (size_t i = 0; i < images.status.data.size(); ++i) {
+    const int u = int(i % size_t(cam.width)), v = int(i / size_t(cam.width));
+    if (images.status.data[i] != uint8_t(RayStatus::kHit)) {
+      EXPECT_EQ(images.depth.data[i], 0.f);
+      EXPECT_TRUE(images.vertex_W.data[i].array().isNaN().all());
+      EXPECT_TRUE(images.normal_W.data[i].array().isNaN().all());
+      EXPECT_EQ(images.color.data[i], 0u);
+      continue;
+    }
+    ++hits;
+    EXPECT_EQ(images.color.data[i], PackRgb(kR, kG, kB));
+    EXPECT_NEAR(images.normal_W.data[i].norm(), 1.f, 1e-4f);
+    // The vertex lies on the pixel's ray at the reported depth.
+    const Eigen::Vector3f expected =
+        T_W_C * cam.Unproject(float(u), float(v), images.depth.data[i]);
+    EXPECT_LT((images.vertex_W.data[i] - expected).norm(), 1e-5f);
+    EXPECT_LT(std::abs(sphere.Sdf(images.vertex_W.data[i])), 0.25f * kVoxel);
+  }
+  // Rays past the silhouette cross allocated free space or nothing at all.
+  EXPECT_GT(Count(images, RayStatus::kFree) + Count(images, RayStatus::kUnobserved), 0u);
+  EXPECT_EQ(hits + Count(images, RayStatus::kFree) + Count(images, RayStatus::kUnobserved),
+            images.status.data.size());
+}
+
+TEST(Raycast, BoxWithNegativeFy) {
+  // ICL-NUIM's cameras flip the image y axis; the raycast must agree with the analytic render.
+  const Box box{Eigen::Vector3f(-0.2f, -0.15f, -0.1f), Eigen::Vector3f(0.25f, 0.2f, 0.15f)};
+  const TsdfVolume volume = FillExact([&](const Eigen::Vector3f& p) { return box.Sdf(p); },
+                                      box.lo - Eigen::Vector3f::Constant(0.15f),
+                                      box.hi + Eigen::Vector3f::Constant(0.15f));
+  PinholeCamera cam = TestCamera(160, 120);
+  cam.fy = -cam.fy;
+  const Pose3f T_W_C =
+      LookAt(Eigen::Vector3f(0.8f, 0.6f, 0.7f), Eigen::Vector3f(0.02f, 0.02f, 0.f));
+  const RaycastImages images = Raycast(volume, cam, T_W_C);
+  const DepthImage truth = test::RenderDepth(box, cam, T_W_C);
+  // Normals are checked below, away from the edges where the SDF bends within a voxel.
+  const Errors e = Compare(images, truth, cam, T_W_C,
+                           [](const Eigen::Vector3f&) { return Eigen::Vector3f::UnitX(); });
+  std::printf("box: depth error median %.4f max %.4f voxel, %zu px\n", e.median_vox, e.max_vox,
+              e.checked);
+  ASSERT_GT(e.checked, 1500u);
+  EXPECT_EQ(e.missed, 0u);
+  EXPECT_LE(e.median_vox, kMedianDepthVox);
+  // Edges of the box: the SDF is not linear within a voxel of them.
+  size_t far_from_edges = 0, bad_normals = 0;
+  for (int v = 0; v < cam.height; ++v)
+    for (int u = 0; u < cam.width; ++u) {
+      if (!Interior(truth, u, v, 2) || images.status.at(u, v) != uint8_t(RayStatus::kHit)) continue;
+      const Eigen::Vector3f p = T_W_C * cam.Unproject(float(u), float(v), truth.at(u, v));
+      int near_faces = 0;
+      for (int a = 0; a < 3; ++a)
+        near_faces +=
+            std::min(std::abs(p[a] - box.lo[a]), std::abs(p[a] - box.hi[a])) < 2.5f * kVoxel;
+      if (near_faces > 1) continue;
+      ++far_from_edges;
+      EXPECT_LE(std::abs(images.depth.at(u, v) - truth.at(u, v)) / kVoxel, kMaxDepthVox);
+      Eigen::Vector3f n = Eigen::Vector3f::Zero();
+      for (int a = 0; a < 3; ++a) {
+        if (std::abs(p[a] - box.lo[a]) < 1e-3f) n[a] = -1.f;
+        if (std::abs(p[a] - box.hi[a]) < 1e-3f) n[a] = 1.f;
+      }
+      bad_normals += images.normal_W.at(u, v).dot(n) < std::cos(kMaxNormalDeg * M_PI / 180.0);
+    }
+  EXPECT_GT(far_from_edges, 1000u);
+  EXPECT_EQ(bad_normals, 0u);
+}
+
+// A wall at x = 0.5 seen head-on from the origin, its whole neighbourhood allocated.
+struct Wall {
+  Plane plane{Eigen::Vector3f(-1.f, 0.f, 0.f), -0.5f};  // free space at x < 0.5
+  Pose3f T_W_C = LookAt(Eigen::Vector3f(0.f, 0.01f, 0.02f), Eigen::Vector3f(1.f, 0.01f, 0.02f));
+  PinholeCamera cam = TestCamera(80, 60);
+  TsdfVolume volume = FillExact([this](const Eigen::Vector3f& p) { return plane.Sdf(p); },
+                                Eigen::Vector3f(0.2f, -0.4f, -0.4f),
+                                Eigen::Vector3f(0.6f, 0.4f, 0.4f), /*all_blocks=*/true);
+};
+
+TEST(Raycast, UnobservedGapInFrontOfTheSurfaceStopsNothing) {
+  Wall wall;
+  const RaycastImages before = Raycast(wall.volume, wall.cam, wall.T_W_C);
+  // Unobserve a slab from 20 cm to 6 voxels in front of the wall, and drop one whole block
+  // column in front of it, so rays cross both unobserved voxels and unallocated blocks.
+  wall.volume.ForEachBlock([&](BlockIndex b, const TsdfBlock&) {
+    TsdfBlock& data = *wall.volume.FindBlock(b);
+    for (int i = 0; i < kBlockVoxels; ++i) {
+      const float x = VoxelCenter(GlobalOf(b, VoxelOfLinear(i)), kVoxel).x();
+      if (x > 0.2f && x < 0.5f - 6 * kVoxel) data.weight[i] = 0;
+    }
+  });
+  const float block = kVoxel * kBlockSide;
+  for (int by = -4; by <= 4; ++by)
+    for (int bz = -4; bz <= 4; ++bz) wall.volume.EraseBlock(BlockIndex{int(0.45f / block), by, bz});
+  const RaycastImages after = Raycast(wall.volume, wall.cam, wall.T_W_C);
+  const DepthImage truth = test::RenderDepth(wall.plane, wall.cam, wall.T_W_C);
+  for (int v = 0; v < wall.cam.height; ++v)
+    for (int u = 0; u < wall.cam.width; ++u) {
+      ASSERT_EQ(after.status.at(u, v), uint8_t(RayStatus::kHit)) << u << " " << v;
+      EXPECT_NEAR(after.depth.at(u, v), truth.at(u, v), kMaxDepthVox * kVoxel);
+      EXPECT_NEAR(after.depth.at(u, v), before.depth.at(u, v), 1e-5f);
+    }
+}
+
+TEST(Raycast, FreeAndUnobservedStatus) {
+  // Observed free space only: a cube of +1 voxels in front of the camera, nothing elsewhere.
+  TsdfVolume volume({kVoxel, kTrunc});
+  for (int x = 2; x <= 5; ++x)
+    for (int y = -1; y <= 0; ++y)
+      for (int z = -1; z <= 0; ++z) {
+        TsdfBlock& data = volume.FindOrAllocate(BlockIndex{x, y, z});
+        for (int i = 0; i < kBlockVoxels; ++i) data.weight[i] = EncodeWeight(1.f);
+      }
+  const PinholeCamera cam = TestCamera(80, 60);
+  const Pose3f T_W_C = LookAt(Eigen::Vector3f::Zero(), Eigen::Vector3f::UnitX());
+  const RaycastImages images = Raycast(volume, cam, T_W_C);
+  EXPECT_EQ(Count(images, RayStatus::kHit), 0u);
+  EXPECT_EQ(images.status.at(cam.width / 2, cam.height / 2), uint8_t(RayStatus::kFree));
+  EXPECT_EQ(images.status.at(0, 0), uint8_t(RayStatus::kUnobserved));
+  EXPECT_GT(Count(images, RayStatus::kFree), 100u);
+  EXPECT_GT(Count(images, RayStatus::kUnobserved), 100u);
+
+  // The same blocks left unobserved (weight below min_weight) are unobserved space.
+  RaycastParams params;
+  params.min_weight = 2.f;
+  EXPECT_EQ(Count(Raycast(volume, cam, T_W_C, params), RayStatus::kUnobserved),
+            size_t(cam.width) * size_t(cam.height));
+  // An empty volume: nothing observed anywhere.
+  EXPECT_EQ(Count(Raycast(TsdfVolume({kVoxel, kTrunc}), cam, T_W_C), RayStatus::kUnobserved),
+            size_t(cam.width) * size_t(cam.height));
+}
+
+TEST(Raycast, CameraInsideASolidSeesOnlyBackFaces) {
+  const Sphere sphere{Eigen::Vector3f(0.f, 0.f, 0.f), 0.3f};
+  const TsdfVolume volume =
+      FillExact([&](const Eigen::Vector3f& p) { return sphere.Sdf(p); },
+                Eigen::Vector3f::Constant(-0.45f), Eigen::Vector3f::Constant(0.45f));
+  const RaycastImages images = Raycast(volume, TestCamera(80, 60),
+                                       LookAt(Eigen::Vector3f::Zero(), Eigen::Vector3f::UnitX()));
+  EXPECT_EQ(Count(images, RayStatus::kHit), 0u);
+  EXPECT_EQ(Count(images, RayStatus::kFree), images.status.data.size());
+}
+
+TEST(Raycast, DepthLimitsAreRespected) {
+  const Sphere sphere{Eigen::Vector3f(1.2f, 0.f, 0.f), 0.3f};  // front at 0.9 m, back at 1.5 m
+  const TsdfVolume volume = FillExact([&](const Eigen::Vector3f& p) { return sphere.Sdf(p); },
+                                      sphere.c - Eigen::Vector3f::Constant(0.45f),
+                                      sphere.c + Eigen::Vector3f::Constant(0.45f));
+  const PinholeCamera cam = TestCamera(80, 60);
+  const Pose3f T_W_C = LookAt(Eigen::Vector3f::Zero(), sphere.c);
+  const size_t pixels = size_t(cam.width) * size_t(cam.height);
+  RaycastParams params;
+  const RaycastImages full = Raycast(volume, cam, T_W_C, params);
+  const size_t all_hits = Count(full, RayStatus::kHit);
+  ASSERT_GT(all_hits, 500u);
+
+  params.max_depth_m = 0.85f;  // in front of the sphere
+  EXPECT_EQ(Count(Raycast(volume, cam, T_W_C, params), RayStatus::kHit), 0u);
+
+  params.max_depth_m = 0.95f;  // cuts through the cap: only the nearest points remain
+  const RaycastImages capped = Raycast(volume, cam, T_W_C, params);
+  const size_t cap_hits = Count(capped, RayStatus::kHit);
+  EXPECT_GT(cap_hits, 0u);
+  EXPECT_LT(cap_hits, all_hits);
+  for (size_t i = 0; i < pixels; ++i)
+    if (capped.status.data[i] == uint8_t(RayStatus::kHit)) {
+      EXPECT_LE(capped.depth.data[i], params.max_depth_m);
+      EXPECT_EQ(capped.depth.data[i], full.depth.data[i]);
+    }
+
+  params.max_depth_m = 5.f;
+  params.min_depth_m = 0.95f;  // cuts the cap: rays starting inside meet only the back face
+  const RaycastImages inside = Raycast(volume, cam, T_W_C, params);
+  // Grazing rays may clip less than a voxel of the solid; compare away from the silhouette.
+  const DepthImage truth = test::RenderDepth(sphere, cam, T_W_C);
+  size_t near_cut = 0, beyond_cut = 0;
+  for (size_t i = 0; i < pixels; ++i) {
+    const int u = int(i % size_t(cam.width)), v = int(i / size_t(cam.width));
+    if (full.status.data[i] != uint8_t(RayStatus::kHit) || !Interior(truth, u, v, 2)) continue;
+    const bool hit = inside.status.data[i] == uint8_t(RayStatus::kHit);
+    if (full.depth.data[i] < params.min_depth_m - kVoxel) {
+      ++near_cut;
+      EXPECT_FALSE(hit) << "surface in front of min_depth";
+    } else if (full.depth.data[i] > params.min_depth_m + kVoxel) {
+      ++beyond_cut;
+      EXPECT_TRUE(hit);
+      EXPECT_NEAR(inside.depth.data[i], full.depth.data[i], 0.01f * kVoxel);
+    }
+  }
+  EXPECT_GT(near_cut, 20u);
+  EXPECT_GT(beyond_cut, 20u);
+}
+
+TEST(Raycast, OneAndTwoThreadsGiveIdenticalBytes) {
+  const Sphere sphere{Eigen::Vector3f(0.f, 0.f, 0.f), 0.3f};
+  const Box box{Eigen::Vector3f(-0.6f, -0.6f, -0.5f), Eigen::Vector3f(0.6f, 0.6f, -0.4f)};
+  const TsdfVolume volume =
+      FillExact([&](const Eigen::Vector3f& p) { return std::min(sphere.Sdf(p), box.Sdf(p)); },
+                Eigen::Vector3f(-0.7f, -0.7f, -0.6f), Eigen::Vector3f(0.7f, 0.7f, 0.4f));
+  const PinholeCamera cam = TestCamera(320, 240);
+  const Pose3f T_W_C = LookAt(Eigen::Vector3f(0.9f, 0.7f, 0.6f), Eigen::Vector3f::Zero());
+  RaycastImages one, two;
+  {
+    ThreadLimit limit(1);
+    one = Raycast(volume, cam, T_W_C);
+  }
+  {
+    ThreadLimit limit(2);
+    two = Raycast(volume, cam, T_W_C);
+  }
+  ASSERT_GT(Count(one, RayStatus::kHit), 10000u);
+  auto same = [](const auto& a, const auto& b) {
+    return a.data.size() == b.data.size() &&
+           std::memcmp(a.data.data(), b.data.data(), a.data.size() * sizeof(a.data[0])) == 0;
+  };
+  EXPECT_TRUE(same(one.depth, two.depth));
+  EXPECT_TRUE(same(one.vertex_W, two.vertex_W));
+  EXPECT_TRUE(same(one.normal_W, two.normal_W));
+  EXPECT_TRUE(same(one.color, two.color));
+  EXPECT_TRUE(same(one.status, two.status));
+
+  // Reusing images gives the same bytes again.
+  RaycastImages reused = one;
+  Raycast(volume, cam, T_W_C, {}, reused);
+  EXPECT_TRUE(same(one.depth, reused.depth));
+  EXPECT_TRUE(same(one.normal_W, reused.normal_W));
+}
+
+TEST(Raycast, InvalidInputsGiveEmptyOrUnobservedImages) {
+  const Sphere sphere{Eigen::Vector3f(0.f, 0.f, 0.f), 0.3f};
+  const TsdfVolume volume =
+      FillExact([&](const Eigen::Vector3f& p) { return sphere.Sdf(p); },
+                Eigen::Vector3f::Constant(-0.45f), Eigen::Vector3f::Constant(0.45f));
+  PinholeCamera bad = TestCamera(80, 60);
+  bad.fx = 0.f;
+  EXPECT_TRUE(Raycast(volume, bad, Pose3f::Identity()).status.empty());
+  Pose3f nan_pose = LookAt(Eigen::Vector3f(1.f, 0.f, 0.f), Eigen::Vector3f::Zero());
+  nan_pose.translation().x() = std::numeric_limits<float>::quiet_NaN();
+  const RaycastImages images = Raycast(volume, TestCamera(80, 60), nan_pose);
+  EXPECT_EQ(Count(images, RayStatus::kUnobserved), images.status.data.size());
+}
+
+}  // namespace
+}  // namespace voxplan
