@@ -16,7 +16,9 @@ constexpr int kLanes = 4;      // rays a worker marches interleaved
 // Step as a fraction of the stored distance: the nearest voxel's centre can be up to 0.87 voxel
 // from the sample, and the negative band behind a surface is what catches an overshoot.
 constexpr float kStepScale = 0.9f;
-constexpr int kNewtonIterations = 3;
+// Two Newton steps from the linear guess land within a hundredth of a voxel on a smooth
+// surface; each further step costs a cell gather and changes the depth by less.
+constexpr int kNewtonIterations = 2;
 constexpr float kConvergedVoxels = 0.05f;   // a Newton step this small ends the search
 constexpr float kMinSlopeFraction = 0.05f;  // of the head-on slope; below it, the ray grazes
 constexpr int kSecantIterations = 3;
@@ -28,11 +30,22 @@ constexpr float kNaN = std::numeric_limits<float>::quiet_NaN();
 struct RangeImage {
   int cols = 0, rows = 0;
   std::vector<float> z_min, z_max;  // z_min > z_max where no block projects
+  // The nearest depth of blocks holding an observed negative voxel: a surface crossing can
+  // only end in such a block, so rays that can hit start just in front of it.
+  std::vector<float> surface_z_min;
 };
 
 struct Chunk {
-  std::vector<float> z_min, z_max;
+  std::vector<float> z_min, z_max, surface_z_min;
 };
+
+// Whether a block holds an observed voxel behind a surface (negative distance).
+bool HasNegativeVoxel(const TsdfBlock& block, uint16_t min_weight_fixed) {
+  int count = 0;  // branch-free, so the loop vectorises
+  for (int i = 0; i < kBlockVoxels; ++i)
+    count += int(block.tsdf[i] < 0) & int(block.weight[i] >= min_weight_fixed);
+  return count > 0;
+}
 
 // The depth where marching starts: a voxel before min_depth, so that a surface just beyond it
 // is approached from its positive side (crossings in front of min_depth are not reported).
@@ -49,8 +62,15 @@ RangeImage BuildRangeImage(const TsdfVolume& volume, const PinholeCamera& camera
   constexpr float kInf = std::numeric_limits<float>::infinity();
 
   std::vector<BlockIndex> blocks;
+  std::vector<const TsdfBlock*> block_data;
   blocks.reserve(volume.num_blocks());
-  volume.ForEachBlock([&](BlockIndex b, const TsdfBlock&) { blocks.push_back(b); });
+  block_data.reserve(volume.num_blocks());
+  volume.ForEachBlock([&](BlockIndex b, const TsdfBlock& data) {
+    blocks.push_back(b);
+    block_data.push_back(&data);
+  });
+  const uint16_t min_weight_fixed =
+      uint16_t(std::clamp(std::ceil(params.min_weight * kWeightScale), 1.f, 65535.f));
 
   // Min and max are order-independent, so the chunking (and the thread count) cannot change
   // the result; each chunk owns its partial image, so nothing is shared while splatting.
@@ -70,6 +90,7 @@ RangeImage BuildRangeImage(const TsdfVolume& volume, const PinholeCamera& camera
       Chunk& chunk = chunks[c];
       chunk.z_min.assign(num_cells, kInf);
       chunk.z_max.assign(num_cells, -kInf);
+      chunk.surface_z_min.assign(num_cells, kInf);
       const size_t first = blocks.size() * c / num_chunks;
       const size_t last = blocks.size() * (c + 1) / num_chunks;
       for (size_t k = first; k < last; ++k) {
@@ -114,11 +135,13 @@ RangeImage BuildRangeImage(const TsdfVolume& volume, const PinholeCamera& camera
         const float v_hi = std::min(std::floor(v_max + kPixelMargin), float(camera.height - 1));
         if (u_lo > u_hi || v_lo > v_hi) continue;
         const float z_lo = std::max(box_z_min, z_near), z_hi = box_z_max;
+        const bool surface = HasNegativeVoxel(*block_data[k], min_weight_fixed);
         for (int cy = int(v_lo) / kRangeCell; cy <= int(v_hi) / kRangeCell; ++cy)
           for (int cx = int(u_lo) / kRangeCell; cx <= int(u_hi) / kRangeCell; ++cx) {
             const size_t cell = size_t(cy) * size_t(range.cols) + size_t(cx);
             chunk.z_min[cell] = std::min(chunk.z_min[cell], z_lo);
             chunk.z_max[cell] = std::max(chunk.z_max[cell], z_hi);
+            if (surface) chunk.surface_z_min[cell] = std::min(chunk.surface_z_min[cell], z_lo);
           }
       }
     }
@@ -126,18 +149,14 @@ RangeImage BuildRangeImage(const TsdfVolume& volume, const PinholeCamera& camera
 
   range.z_min.assign(num_cells, kInf);
   range.z_max.assign(num_cells, -kInf);
+  range.surface_z_min.assign(num_cells, kInf);
   for (const Chunk& chunk : chunks)
     for (size_t i = 0; i < num_cells; ++i) {
       range.z_min[i] = std::min(range.z_min[i], chunk.z_min[i]);
       range.z_max[i] = std::max(range.z_max[i], chunk.z_max[i]);
+      range.surface_z_min[i] = std::min(range.surface_z_min[i], chunk.surface_z_min[i]);
     }
   return range;
-}
-
-// floor() for coordinates far inside the int range; std::floor is a slow sequence without SSE4.1.
-inline int32_t FloorToInt(float x) {
-  const int32_t i = int32_t(x);
-  return i - int32_t(float(i) > x);
 }
 
 // The 2x2x2 voxel centres around a point, for trilinear interpolation of TSDF, colour and the
@@ -313,12 +332,16 @@ uint32_t CellColor(const Cell& cell) {
 struct Ray {
   Eigen::Vector3f dir_W, inv_dir;
   float z = 0.f, z_end = 0.f;
-  float voxel_z = 0.f;       // one voxel along the ray, in depth units
-  float step_scale_z = 0.f;  // stored fixed-point TSDF to a step in depth units
-  bool have_prev = false;    // previous sample observed, nothing unobserved since
+  float voxel_z = 0.f;                  // one voxel along the ray, in depth units
+  float step_scale_z = 0.f;             // stored fixed-point TSDF to a step in depth units
+  bool have_prev = false;               // previous sample observed, nothing unobserved since
+  Eigen::Vector3f origin_vox, dir_vox;  // the ray in voxel units: p = origin + z * dir
+  BlockIndex block_index{kMaxBlockCoord + 1, 0, 0};  // the last block this ray sampled
+  const TsdfBlock* block = nullptr;
   float prev_z = 0.f;
   int16_t prev_tsdf = 0;
   size_t pixel = 0;
+  float z_restart = -1.f;  // >= 0: on a miss, march again from here (the cell's first block)
   RayResult result;
 };
 
@@ -339,18 +362,24 @@ class RayCaster {
     ray->voxel_z = sampler_.voxel_m() / dir_norm;
     ray->step_scale_z = kStepScale * sampler_.trunc_m() / (kTsdfScale * dir_norm);
     ray->have_prev = false;
+    ray->origin_vox = origin_W_ * sampler_.inv_voxel();
+    ray->dir_vox = dir_W * sampler_.inv_voxel();
+    ray->block_index = BlockIndex{kMaxBlockCoord + 1, 0, 0};
     ray->result = RayResult{};
   }
 
   // Takes one sample; true when the ray is finished and ray->result final.
   bool Step(Ray& ray) {
     if (!(ray.z <= ray.z_end)) return true;
-    const float inv_s = sampler_.inv_voxel();
-    const Eigen::Vector3f p = origin_W_ + ray.z * ray.dir_W;
-    const GlobalVoxelIndex g{FloorToInt(p.x() * inv_s), FloorToInt(p.y() * inv_s),
-                             FloorToInt(p.z() * inv_s)};
+    const Eigen::Vector3f p = ray.origin_vox + ray.z * ray.dir_vox;
+    const GlobalVoxelIndex g{FloorToInt(p.x()), FloorToInt(p.y()), FloorToInt(p.z())};
     const BlockIndex b = BlockOf(g);
-    const TsdfBlock* block = sampler_.Find(b);
+    // Each ray keeps its own last block: interleaved rays would evict a shared one.
+    if (!(b == ray.block_index)) {
+      ray.block_index = b;
+      ray.block = sampler_.Find(b);
+    }
+    const TsdfBlock* block = ray.block;
     if (!block) {
       // Jump to where the ray leaves this unallocated block (nudged past the face).
       const float block_m = sampler_.voxel_m() * kBlockSide;
@@ -372,7 +401,12 @@ class RayCaster {
     ray.result.status = RayStatus::kFree;  // at least: an observed voxel was met
     const int16_t tsdf = block->tsdf[i];
     if (ray.have_prev && (ray.prev_tsdf >= 0) != (tsdf >= 0)) {
-      if (tsdf >= 0) return true;  // back face: entered from behind a surface
+      if (tsdf >= 0) {  // back face: entered from behind a surface
+        if (params_.stop_at_back_faces) return true;
+        ray.have_prev = false;  // march on into the free space beyond
+        ray.z += ray.voxel_z;
+        return false;
+      }
       if (Refine(ray.dir_W, ray.prev_z, ray.z, DecodeTsdf(ray.prev_tsdf), DecodeTsdf(tsdf),
                  ray.voxel_z, &ray.result)) {
         if (ray.result.z < params_.min_depth_m || ray.result.z > params_.max_depth_m) {
@@ -423,7 +457,7 @@ class RayCaster {
       if (!(z + dz > z_a - voxel_z && z + dz < z_b + voxel_z)) break;
       // The last step is not re-sampled: the gradient and colour barely change over it.
       z += dz;
-      if (std::abs(dz) < kConvergedVoxels * voxel_z) {
+      if (k + 1 == kNewtonIterations || std::abs(dz) < kConvergedVoxels * voxel_z) {
         converged = true;
         break;
       }
@@ -542,12 +576,18 @@ void Raycast(const TsdfVolume& volume, const PinholeCamera& camera, const Pose3f
           if (usable) {
             const size_t cell =
                 size_t(v / kRangeCell) * size_t(range.cols) + size_t(u / kRangeCell);
-            const float z_begin = std::max(range.z_min[cell], z_start);
+            const float z_all = std::max(range.z_min[cell], z_start);
             const float z_end = std::min(range.z_max[cell], params.max_depth_m);
-            if (z_begin <= z_end) {
+            // Start two voxels in front of the nearest block that can end a crossing, so the
+            // sample before the crossing is still taken.
+            const float z_surface =
+                std::max(range.surface_z_min[cell] - 2.f * volume.voxel_size_m(), z_all);
+            if (z_all <= z_end) {
               const Eigen::Vector3f dir_C((float(u) - camera.cx) / camera.fx,
                                           (float(v) - camera.cy) / camera.fy, 1.f);
-              caster.Start(R_W_C * dir_C, z_begin, z_end, ray);
+              const bool skip = z_surface <= z_end && z_surface > z_all;
+              caster.Start(R_W_C * dir_C, skip ? z_surface : z_all, z_end, ray);
+              ray->z_restart = skip ? z_all : -1.f;
               ray->pixel = px;
               return true;
             }
@@ -563,6 +603,13 @@ void Raycast(const TsdfVolume& volume, const PinholeCamera& camera, const Pose3f
       while (num_live > 0)
         for (int l = 0; l < kLanes; ++l) {
           if (!live[l] || !caster.Step(rays[l])) continue;
+          if (rays[l].result.status != RayStatus::kHit && rays[l].z_restart >= 0.f) {
+            // A miss after skipping free space: march the whole range, so the status says
+            // whether the ray met observed space.
+            caster.Start(rays[l].dir_W, rays[l].z_restart, rays[l].z_end, &rays[l]);
+            rays[l].z_restart = -1.f;
+            continue;
+          }
           write(rays[l].pixel, rays[l].result, rays[l].dir_W);
           if (!start_next(&rays[l])) live[l] = false, --num_live;
         }

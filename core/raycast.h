@@ -18,6 +18,9 @@ struct RaycastParams {
   float min_depth_m = 0.1f;
   float max_depth_m = 5.0f;
   float min_weight = 0.5f;  // voxels with less weight count as unobserved
+  // A ray entering a surface from behind (negative to positive) stops there as kFree, as
+  // tracking wants; renders from outside a room march on to see its inside.
+  bool stop_at_back_faces = true;
 };
 
 enum class RayStatus : uint8_t {

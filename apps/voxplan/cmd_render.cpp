@@ -88,6 +88,8 @@ class MapScene : public Scene {
   MapScene(TsdfVolume volume, float min_weight, float near_m) : volume_(std::move(volume)) {
     params_.min_weight = min_weight;
     params_.min_depth_m = near_m > 0.0f ? near_m : 0.01f;
+    // From outside a room the walls' backs come first: look through them at the inside.
+    params_.stop_at_back_faces = false;
     const float block_m = volume_.block_size_m();
     volume_.ForEachBlock([&](BlockIndex b, const TsdfBlock&) {
       const Eigen::Vector3f lo = BlockOrigin(b, block_m);
