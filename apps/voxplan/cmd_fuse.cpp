@@ -4,6 +4,7 @@
 #include <iostream>
 #include <map>
 #include <memory>
+#include <optional>
 #include <sstream>
 
 #include "apps/voxplan/cli_common.h"
@@ -11,9 +12,11 @@
 #include "core/volume.h"
 #include "fusion/integrate.h"
 #include "fusion/mesh_extract.h"
+#include "fusion/tracking.h"
 #include "io/dataset.h"
 #include "io/map_io.h"
 #include "io/mesh_io.h"
+#include "sim/eval_trajectory.h"
 
 namespace voxplan::cli {
 
@@ -44,7 +47,9 @@ struct FuseOptions {
   std::string kernel = "auto";
   double max_weight = 64.0;
   double mesh_min_weight = 0.5;
-  std::string mesh_path, map_path, stats_path, frame_list_path;
+  std::string mesh_path, map_path, stats_path, frame_list_path, trajectory_path;
+  bool track = false;
+  double photometric_weight = 0.0;
 };
 
 // Beyond this many, per-frame skip warnings collapse into one count at the end.
@@ -117,7 +122,18 @@ int RunFuse(const FuseOptions& o) {
 
   std::vector<double> load_ms, integrate_ms, frame_ms;
   nlohmann::json frame_list = nlohmann::json::array();
-  size_t skipped_no_pose = 0, skipped_empty = 0;
+  size_t skipped_no_pose = 0, skipped_empty = 0, frames_lost = 0;
+  std::vector<double> track_ms, trajectory_t;
+  std::vector<Pose3f> trajectory;
+  std::optional<FrameTracker> tracker;
+  bool tracker_started = false;
+  if (o.track) {
+    TrackingParams tracking;
+    tracking.photometric_weight = float(o.photometric_weight);
+    tracking.raycast.max_depth_m = float(o.max_depth_m);
+    tracking.raycast.min_depth_m = float(o.min_depth_m);
+    tracker.emplace(info.camera, tracking);
+  }
   Progress progress("fuse", indices.size());
   const Stopwatch loop_clock;
   for (size_t k = 0; k < indices.size(); ++k) {
@@ -129,20 +145,45 @@ int RunFuse(const FuseOptions& o) {
       progress.Finish();
       return Fail("frame " + std::to_string(i) + ": " + frame.status().message());
     }
-    if (!frame->T_W_C) {
-      if (++skipped_no_pose <= kMaxSkipWarnings) {
-        progress.Warn("frame " + std::to_string(i) + " (" + frame->depth_path +
-                      ") has no pose; skipped");
-      }
-    } else if (AllZero(frame->depth)) {
+    if (AllZero(frame->depth)) {
       if (++skipped_empty <= kMaxSkipWarnings) {
         progress.Warn("frame " + std::to_string(i) + " (" + frame->depth_path +
                       ") has no valid depth; skipped");
       }
-    } else {
+      progress.Update(k + 1);
+      continue;
+    }
+    // The pose to integrate with: the dataset's, or with --track the tracker's (the first
+    // frame starts from the dataset pose when there is one, else the identity).
+    std::optional<Pose3f> T_W_C;
+    if (tracker && !tracker_started) {
+      T_W_C = frame->T_W_C ? Pose3f(frame->T_W_C->cast<float>()) : Pose3f::Identity();
+      tracker->Reset(*T_W_C);
+      tracker_started = true;
+    } else if (tracker) {
+      Result<TrackingResult> tracked = tracker->Track(frame->depth, frame->color, volume);
+      if (!tracked.ok()) {
+        progress.Finish();
+        return Fail(MessageNaming(tracked.status(), frame->depth_path));
+      }
+      track_ms.push_back(tracked->track_ms);
+      if (tracked->ok) {
+        T_W_C = tracked->T_W_C;
+        tracker->Accept(*T_W_C);
+      } else if (++frames_lost <= kMaxSkipWarnings) {
+        progress.Warn("frame " + std::to_string(i) + " (" + frame->depth_path +
+                      ") lost tracking (" + tracked->failure + "); not integrated");
+      }
+    } else if (frame->T_W_C) {
+      T_W_C = frame->T_W_C->cast<float>();
+    } else if (++skipped_no_pose <= kMaxSkipWarnings) {
+      progress.Warn("frame " + std::to_string(i) + " (" + frame->depth_path +
+                    ") has no pose; skipped");
+    }
+    if (T_W_C) {
       const Stopwatch integrate_clock;
-      Result<IntegrateStats> stats = IntegrateFrame(frame->depth, frame->color, info.camera,
-                                                    frame->T_W_C->cast<float>(), params, volume);
+      Result<IntegrateStats> stats =
+          IntegrateFrame(frame->depth, frame->color, info.camera, *T_W_C, params, volume);
       const double integrate = integrate_clock.ElapsedMs();
       if (!stats.ok()) {
         progress.Finish();
@@ -151,8 +192,10 @@ int RunFuse(const FuseOptions& o) {
       load_ms.push_back(load);
       integrate_ms.push_back(integrate);
       frame_ms.push_back(load + integrate);
+      trajectory_t.push_back(frame->timestamp);
+      trajectory.push_back(*T_W_C);
       if (!o.frame_list_path.empty()) {
-        const Eigen::Matrix<double, 4, 4, Eigen::RowMajor> T = frame->T_W_C->matrix();
+        const Eigen::Matrix<double, 4, 4, Eigen::RowMajor> T = T_W_C->matrix().cast<double>();
         frame_list.push_back({{"depth", frame->depth_path},
                               {"color", frame->color_path},
                               {"T_W_C", std::vector<double>(T.data(), T.data() + 16)}});
@@ -164,6 +207,9 @@ int RunFuse(const FuseOptions& o) {
   const double loop_s = loop_clock.ElapsedMs() / 1000.0;
   if (skipped_no_pose > kMaxSkipWarnings) {
     Warn(std::to_string(skipped_no_pose) + " frames in all had no pose and were skipped");
+  }
+  if (frames_lost > kMaxSkipWarnings) {
+    Warn(std::to_string(frames_lost) + " frames in all lost tracking and were not integrated");
   }
   if (skipped_empty > kMaxSkipWarnings) {
     Warn(std::to_string(skipped_empty) + " frames in all had no valid depth and were skipped");
@@ -187,6 +233,10 @@ int RunFuse(const FuseOptions& o) {
   }
   if (!o.map_path.empty()) {
     if (Status s = SaveMap(volume, o.map_path); !s.ok()) return Fail(MessageNaming(s, o.map_path));
+  }
+  if (!o.trajectory_path.empty()) {
+    if (Status s = WriteTumTrajectory(o.trajectory_path, trajectory_t, trajectory); !s.ok())
+      return Fail(MessageNaming(s, o.trajectory_path));
   }
   if (!o.frame_list_path.empty()) {
     // Exactly the frames integrated, with the parameters, for reference runs of other
@@ -218,6 +268,10 @@ int RunFuse(const FuseOptions& o) {
   j["frames_selected"] = indices.size();
   j["frames_skipped"] = skipped_no_pose + skipped_empty;
   j["frames_skipped_no_pose"] = skipped_no_pose;
+  j["tracking"] = o.track;
+  j["frames_lost"] = frames_lost;
+  j["track_ms_median"] = RoundTo(Summarize(track_ms).median, 3);
+  j["trajectory"] = OrNull(o.trajectory_path);
   j["frames_skipped_no_depth"] = skipped_empty;
   j["voxel_size_m"] = o.voxel_size_m;
   j["trunc_m"] = o.trunc_m;
@@ -320,6 +374,15 @@ Command AddFuseCommand(CLI::App& app) {
       ->check(MeshOutputValidator());
   sub->add_option("--map", o->map_path, "Write the map (.vpmap)")->check(OutputFileValidator());
   sub->add_option("--stats", o->stats_path, "Write the stats JSON")->check(OutputFileValidator());
+  sub->add_flag("--track", o->track,
+                "Estimate poses by frame-to-model ICP instead of using the dataset's");
+  sub->add_option("--photometric-weight", o->photometric_weight,
+                  "With --track: weight of the colour term (0: geometry only)")
+      ->check(NonNegative())
+      ->capture_default_str();
+  sub->add_option("--trajectory", o->trajectory_path,
+                  "Write the poses used (TUM format: t tx ty tz qx qy qz qw)")
+      ->check(OutputFileValidator());
   sub->add_option("--frame-list", o->frame_list_path,
                   "Write the integrated frames (paths, poses, intrinsics) as JSON")
       ->check(OutputFileValidator());
