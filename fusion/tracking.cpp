@@ -5,6 +5,7 @@
 #include <chrono>
 #include <cmath>
 #include <limits>
+#include <memory>
 #include <opencv2/imgproc.hpp>
 #include <stdexcept>
 #include <vector>
@@ -16,8 +17,8 @@ namespace voxplan {
 namespace {
 
 constexpr int kLevels = 3;
-// Rows per reduction chunk: the chunks are fixed by the image size, never by the scheduler, and
-// summed in chunk order, so the normal equations are bit-identical for any thread count.
+// Points per reduction chunk: the chunks are fixed by the point count, never by the scheduler,
+// and summed in chunk order, so the normal equations are bit-identical for any thread count.
 constexpr size_t kPointsPerChunk = 4096;
 constexpr size_t kPointsPerFloatRun = 256;  // float partial sums stay short, then go to double
 constexpr size_t kMinCorrespondences = 64;  // per level; fewer cannot constrain 6 DoF reliably
@@ -32,8 +33,6 @@ double MsSince(Clock::time_point t0) {
   return std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
 }
 
-const float kNaN = std::numeric_limits<float>::quiet_NaN();
-
 // A pixel with a vertex and a normal, packed so the ICP loop streams through memory.
 struct InputPoint {
   Eigen::Vector3f p_C;
@@ -45,17 +44,25 @@ struct InputPoint {
 struct InputLevel {
   PinholeCamera camera;
   DepthImage depth;
-  Image<Eigen::Vector3f> vertex_C;  // NaN where invalid
-  Image<Eigen::Vector3f> normal_C;  // NaN where the neighbourhood is invalid
-  Image<float> intensity;           // [0, 1]; empty without colour
-  std::vector<InputPoint> points;   // pixels with a normal, row-major
+  Image<float> intensity;          // [0, 1]; empty without colour
+  std::vector<InputPoint> points;  // pixels with a normal, row-major
   size_t valid_pixels = 0;
 };
+
+constexpr int kRowsPerBand = 16;  // rows of one parallel task when building the points
+
+// Reuses the image's storage: the tracker keeps its buffers from frame to frame.
+template <typename T>
+void Reshape(Image<T>& image, int width, int height, T fill) {
+  image.width = width;
+  image.height = height;
+  image.data.assign(size_t(width) * size_t(height), fill);
+}
 
 struct ModelImages {
   PinholeCamera camera;
   RaycastImages raycast;
-  Image<float> intensity;  // empty unless the photometric term is on
+  Image<float> intensity;                     // empty unless the photometric term is on
   Image<Eigen::Vector2f> intensity_gradient;  // per model pixel
 };
 
@@ -80,115 +87,119 @@ PinholeCamera LevelCamera(const PinholeCamera& c, int level) {
 
 // Edge-preserving smoothing of valid depth; invalid pixels (0) stay invalid. A 0 neighbour is
 // metres away in depth, so its range weight vanishes and it does not pull valid pixels down.
-DepthImage FilterDepth(const DepthImage& depth, const TrackingParams& p) {
-  DepthImage in = depth;
-  for (float& d : in.data)
-    if (!(d >= p.raycast.min_depth_m && d <= p.raycast.max_depth_m)) d = 0.f;
-  if (p.bilateral_diameter_px <= 0) return in;
-  DepthImage out(depth.width, depth.height, 0.f);
-  const cv::Mat src(in.height, in.width, CV_32F, in.data.data());
+void FilterDepth(const DepthImage& depth, const TrackingParams& p, DepthImage& masked,
+                 DepthImage& out) {
+  Reshape(masked, depth.width, depth.height, 0.f);
+  for (size_t i = 0; i < depth.data.size(); ++i) {
+    const float d = depth.data[i];
+    if (d >= p.raycast.min_depth_m && d <= p.raycast.max_depth_m) masked.data[i] = d;
+  }
+  if (p.bilateral_diameter_px <= 0) {
+    out = masked;
+    return;
+  }
+  Reshape(out, depth.width, depth.height, 0.f);
+  const cv::Mat src(masked.height, masked.width, CV_32F, masked.data.data());
   cv::Mat dst(out.height, out.width, CV_32F, out.data.data());
   cv::bilateralFilter(src, dst, p.bilateral_diameter_px, p.bilateral_sigma_depth_m,
                       p.bilateral_sigma_space_px, cv::BORDER_REPLICATE);
   for (size_t i = 0; i < out.data.size(); ++i)
-    if (in.data[i] == 0.f || !std::isfinite(out.data[i])) out.data[i] = 0.f;
-  return out;
+    if (masked.data[i] == 0.f || !std::isfinite(out.data[i])) out.data[i] = 0.f;
 }
 
 // Average of the valid pixels of each 2x2 cell that lie within `gate` of the cell's nearest
 // valid depth: no averaging across depth edges, so no flying pixels.
-DepthImage DownsampleDepth(const DepthImage& d, float gate) {
-  DepthImage out(d.width / 2, d.height / 2, 0.f);
-  ParallelFor(size_t(out.height), 16, [&](size_t v0, size_t v1) {
-    for (int v = int(v0); v < int(v1); ++v)
-      for (int u = 0; u < out.width; ++u) {
-        const float z[4] = {d.at(2 * u, 2 * v), d.at(2 * u + 1, 2 * v), d.at(2 * u, 2 * v + 1),
-                            d.at(2 * u + 1, 2 * v + 1)};
-        float ref = std::numeric_limits<float>::infinity();
-        for (float zi : z)
-          if (zi > 0.f) ref = std::min(ref, zi);
-        if (!std::isfinite(ref)) continue;
-        float sum = 0.f;
-        int n = 0;
-        for (float zi : z)
-          if (zi > 0.f && zi - ref <= gate) sum += zi, ++n;
-        out.at(u, v) = sum / float(n);
-      }
-  });
-  return out;
+void DownsampleDepth(const DepthImage& d, float gate, DepthImage& out) {
+  Reshape(out, d.width / 2, d.height / 2, 0.f);
+  for (int v = 0; v < out.height; ++v)
+    for (int u = 0; u < out.width; ++u) {
+      const float z[4] = {d.at(2 * u, 2 * v), d.at(2 * u + 1, 2 * v), d.at(2 * u, 2 * v + 1),
+                          d.at(2 * u + 1, 2 * v + 1)};
+      float ref = std::numeric_limits<float>::infinity();
+      for (float zi : z)
+        if (zi > 0.f) ref = std::min(ref, zi);
+      if (!std::isfinite(ref)) continue;
+      float sum = 0.f;
+      int n = 0;
+      for (float zi : z)
+        if (zi > 0.f && zi - ref <= gate) sum += zi, ++n;
+      out.at(u, v) = sum / float(n);
+    }
 }
 
-Image<float> Intensity(const ColorImage& color) {
-  Image<float> out(color.width, color.height, 0.f);
-  for (size_t i = 0; i < color.data.size(); ++i) {
-    const uint32_t c = color.data[i];
-    out.data[i] = (0.299f * Red(c) + 0.587f * Green(c) + 0.114f * Blue(c)) * (1.f / 255.f);
-  }
-  return out;
+float Luma(uint32_t c) {
+  return (0.299f * Red(c) + 0.587f * Green(c) + 0.114f * Blue(c)) * (1.f / 255.f);
 }
 
-Image<float> DownsampleIntensity(const Image<float>& in) {
-  Image<float> out(in.width / 2, in.height / 2, 0.f);
+void Intensity(const ColorImage& color, Image<float>& out) {
+  Reshape(out, color.width, color.height, 0.f);
+  for (size_t i = 0; i < color.data.size(); ++i) out.data[i] = Luma(color.data[i]);
+}
+
+void DownsampleIntensity(const Image<float>& in, Image<float>& out) {
+  Reshape(out, in.width / 2, in.height / 2, 0.f);
   for (int v = 0; v < out.height; ++v)
     for (int u = 0; u < out.width; ++u)
       out.at(u, v) = 0.25f * (in.at(2 * u, 2 * v) + in.at(2 * u + 1, 2 * v) +
                               in.at(2 * u, 2 * v + 1) + in.at(2 * u + 1, 2 * v + 1));
-  return out;
 }
 
-// Vertices by back-projection; normals from the cross product of central differences, facing
-// the camera. Depth edges (neighbours off the surface) leave the normal invalid.
-void ComputeVertexNormalMaps(InputLevel& level) {
+// Points with normals from the cross product of central differences, facing the camera. Depth
+// edges (a neighbour off the surface) leave a pixel out. Bands of rows run in parallel and are
+// concatenated in order, so the points stay row-major whatever the thread count.
+void BuildPoints(InputLevel& level, std::vector<std::vector<InputPoint>>& bands) {
   const PinholeCamera& cam = level.camera;
   const DepthImage& d = level.depth;
-  const Eigen::Vector3f nan3 = Eigen::Vector3f::Constant(kNaN);
-  level.vertex_C = Image<Eigen::Vector3f>(d.width, d.height, nan3);
-  level.normal_C = Image<Eigen::Vector3f>(d.width, d.height, nan3);
-  std::vector<size_t> row_valid(size_t(d.height), 0);
-  ParallelFor(size_t(d.height), 16, [&](size_t v0, size_t v1) {
-    for (int v = int(v0); v < int(v1); ++v)
-      for (int u = 0; u < d.width; ++u) {
-        const float z = d.at(u, v);
-        if (z <= 0.f) continue;
-        level.vertex_C.at(u, v) = cam.Unproject(float(u), float(v), z);
-        ++row_valid[size_t(v)];
-      }
+  const bool has_intensity = !level.intensity.empty();
+  const float inv_fx = 1.f / cam.fx, inv_fy = 1.f / cam.fy;
+  const size_t num_bands = size_t((d.height + kRowsPerBand - 1) / kRowsPerBand);
+  if (bands.size() < num_bands) bands.resize(num_bands);
+  std::vector<size_t> band_valid(num_bands, 0);
+  ParallelFor(num_bands, 1, [&](size_t b0, size_t b1) {
+    for (size_t b = b0; b < b1; ++b) {
+      std::vector<InputPoint>& out = bands[b];
+      out.clear();
+      const int v_begin = int(b) * kRowsPerBand;
+      const int v_end = std::min(v_begin + kRowsPerBand, d.height);
+      for (int v = v_begin; v < v_end; ++v)
+        for (int u = 0; u < d.width; ++u) {
+          const float z = d.at(u, v);
+          if (z <= 0.f) continue;
+          ++band_valid[b];
+          if (u == 0 || v == 0 || u + 1 == d.width || v + 1 == d.height) continue;
+          const float gate = kNormalDepthGate * z;
+          const float zl = d.at(u - 1, v), zr = d.at(u + 1, v), zu = d.at(u, v - 1),
+                      zd = d.at(u, v + 1);
+          if (!(std::abs(zl - z) <= gate && std::abs(zr - z) <= gate && std::abs(zu - z) <= gate &&
+                std::abs(zd - z) <= gate))
+            continue;  // also rejects an invalid (0) neighbour
+          // Back-projection with the inverse focal lengths: no division per pixel.
+          const float xu = (float(u) - cam.cx) * inv_fx, yv = (float(v) - cam.cy) * inv_fy;
+          const Eigen::Vector3f dx((xu + inv_fx) * zr - (xu - inv_fx) * zl, yv * (zr - zl),
+                                   zr - zl);
+          const Eigen::Vector3f dy(xu * (zd - zu), (yv + inv_fy) * zd - (yv - inv_fy) * zu,
+                                   zd - zu);
+          Eigen::Vector3f n = dx.cross(dy);
+          const float norm2 = n.squaredNorm();
+          if (!(norm2 > 0.f)) continue;
+          n *= 1.f / std::sqrt(norm2);
+          const Eigen::Vector3f p_C(xu * z, yv * z, z);
+          // The sign of the cross product flips with fy; orient by the viewing ray instead.
+          if (n.dot(p_C) > 0.f) n = -n;
+          out.push_back({p_C, n, has_intensity ? level.intensity.at(u, v) : 0.f, 0.f});
+        }
+    }
   });
   level.valid_pixels = 0;
-  for (size_t n : row_valid) level.valid_pixels += n;
-  ParallelFor(size_t(d.height), 16, [&](size_t v0, size_t v1) {
-    for (int v = std::max(int(v0), 1); v < std::min(int(v1), d.height - 1); ++v)
-      for (int u = 1; u < d.width - 1; ++u) {
-        const float z = d.at(u, v);
-        if (z <= 0.f) continue;
-        const float gate = kNormalDepthGate * z;
-        const float zl = d.at(u - 1, v), zr = d.at(u + 1, v), zu = d.at(u, v - 1),
-                    zd = d.at(u, v + 1);
-        if (zl <= 0.f || zr <= 0.f || zu <= 0.f || zd <= 0.f) continue;
-        if (std::abs(zl - z) > gate || std::abs(zr - z) > gate || std::abs(zu - z) > gate ||
-            std::abs(zd - z) > gate)
-          continue;
-        const Eigen::Vector3f dx = level.vertex_C.at(u + 1, v) - level.vertex_C.at(u - 1, v);
-        const Eigen::Vector3f dy = level.vertex_C.at(u, v + 1) - level.vertex_C.at(u, v - 1);
-        Eigen::Vector3f n = dx.cross(dy);
-        const float norm = n.norm();
-        if (!(norm > 0.f)) continue;
-        n /= norm;
-        // The sign of the cross product flips with fy; orient by the viewing ray instead.
-        if (n.dot(level.vertex_C.at(u, v)) > 0.f) n = -n;
-        level.normal_C.at(u, v) = n;
-      }
-  });
+  size_t total = 0;
+  for (size_t b = 0; b < num_bands; ++b) {
+    level.valid_pixels += band_valid[b];
+    total += bands[b].size();
+  }
   level.points.clear();
-  level.points.reserve(level.valid_pixels);
-  const bool has_intensity = !level.intensity.empty();
-  for (int v = 0; v < d.height; ++v)
-    for (int u = 0; u < d.width; ++u) {
-      const Eigen::Vector3f& n = level.normal_C.at(u, v);
-      if (!std::isfinite(n.x())) continue;
-      level.points.push_back({level.vertex_C.at(u, v), n,
-                              has_intensity ? level.intensity.at(u, v) : 0.f, 0.f});
-    }
+  level.points.reserve(total);
+  for (size_t b = 0; b < num_bands; ++b)
+    level.points.insert(level.points.end(), bands[b].begin(), bands[b].end());
 }
 
 // SE(3) exponential of xi = (v, w): rotation exp(w), translation V(w) v.
@@ -223,17 +234,46 @@ struct NormalEquations {
   size_t photometric = 0;
 };
 
-// Rows i < 6 sum w J_i [J, r, 0]: the 6x6 system with the gradient in column 6. Eight floats a
-// row so the compiler turns each row update into two 4-wide multiply-adds.
-struct alignas(32) FloatSums {
-  float a[6][8] = {};
+// Weighted residual terms of one short run, stored column-wise ([J, r] and the weight) and
+// reduced after the run in eight fixed lanes: the products then vectorise across terms without
+// reassociating anything, so the sums stay deterministic.
+struct TermBatch {
+  static constexpr int kCapacity = 2 * int(kPointsPerFloatRun);  // geometric + photometric
+  static constexpr int kLanes = 8;
+  alignas(32) float jr[7][kCapacity];  // J_0..J_5, r
+  alignas(32) float w[kCapacity];
+  int n = 0;
   float r2 = 0.f;
   float p[4] = {};  // x, y, z, squared norm of the inliers
 
-  void Add(const float (&Jr)[8], float w) {
+  void Clear() {
+    n = 0;
+    r2 = 0.f;
+    for (float& v : p) v = 0.f;
+  }
+  void Add(const float (&Jr)[7], float weight) {
+    for (int k = 0; k < 7; ++k) jr[k][n] = Jr[k];
+    w[n] = weight;
+    ++n;
+  }
+  // Adds sum_k w_k J_i,k [J, r]_j,k for i < 6, j in [i, 7) into a[i][j].
+  void ReduceInto(double (&a)[6][8]) {
+    const int padded = (n + kLanes - 1) / kLanes * kLanes;
+    for (int k = n; k < padded; ++k) {
+      w[k] = 0.f;
+      for (int c = 0; c < 7; ++c) jr[c][k] = 0.f;
+    }
+    alignas(32) float wj[kCapacity];
     for (int i = 0; i < 6; ++i) {
-      const float wi = w * Jr[i];
-      for (int j = 0; j < 8; ++j) a[i][j] += wi * Jr[j];
+      for (int k = 0; k < padded; ++k) wj[k] = w[k] * jr[i][k];
+      for (int j = i; j < 7; ++j) {
+        float lane[kLanes] = {};
+        for (int k = 0; k < padded; k += kLanes)
+          for (int l = 0; l < kLanes; ++l) lane[l] += wj[k + l] * jr[j][k + l];
+        float sum = 0.f;
+        for (int l = 0; l < kLanes; ++l) sum += lane[l];
+        a[i][j] += double(sum);
+      }
     }
   }
 };
@@ -246,11 +286,10 @@ struct ChunkSums {
   size_t inliers = 0;
   size_t photometric = 0;
 
-  void Add(const FloatSums& f) {
-    for (int i = 0; i < 6; ++i)
-      for (int j = 0; j < 8; ++j) a[i][j] += double(f.a[i][j]);
-    r2 += double(f.r2);
-    for (int k = 0; k < 4; ++k) p[k] += double(f.p[k]);
+  void Add(TermBatch& batch) {
+    batch.ReduceInto(a);
+    r2 += double(batch.r2);
+    for (int k = 0; k < 4; ++k) p[k] += double(batch.p[k]);
   }
   void Add(const ChunkSums& c) {
     for (int i = 0; i < 6; ++i)
@@ -308,11 +347,13 @@ NormalEquations BuildSystem(const InputLevel& in, const ModelImages& model, cons
   const float max_x = float(mc.width) - 0.5f, max_y = float(mc.height) - 0.5f;
 
   ParallelFor(num_chunks, 1, [&](size_t c0, size_t c1) {
+    const auto batch = std::make_unique<TermBatch>();  // 16 kB: off the task's stack
     for (size_t c = c0; c < c1; ++c) {
       ChunkSums& sums = partial[c];
       const size_t end = std::min((c + 1) * kPointsPerChunk, num_points);
       for (size_t run = c * kPointsPerChunk; run < end; run += kPointsPerFloatRun) {
-        FloatSums f;
+        TermBatch& f = *batch;
+        f.Clear();
         const size_t run_end = std::min(run + kPointsPerFloatRun, end);
         for (size_t i = run; i < run_end; ++i) {
           const InputPoint& pt = in.points[i];
@@ -332,7 +373,7 @@ NormalEquations BuildSystem(const InputLevel& in, const ModelImages& model, cons
           if (!((R_W_C * pt.n_C).dot(n_W) >= cos_gate)) continue;  // also rejects a NaN normal
           const float r = n_W.dot(diff);
           const Eigen::Vector3f pxn = p_W.cross(n_W);
-          const float J[8] = {n_W.x(), n_W.y(), n_W.z(), pxn.x(), pxn.y(), pxn.z(), r, 0.f};
+          const float J[7] = {n_W.x(), n_W.y(), n_W.z(), pxn.x(), pxn.y(), pxn.z(), r};
           f.Add(J, HuberWeight(r, p.huber_delta_m));
           f.r2 += r * r;
           f.p[0] += p_W.x(), f.p[1] += p_W.y(), f.p[2] += p_W.z();
@@ -350,7 +391,7 @@ NormalEquations BuildSystem(const InputLevel& in, const ModelImages& model, cons
           const Eigen::Vector3f g_Cp = grad.x() * d_pix_x + grad.y() * d_pix_y;
           const Eigen::Vector3f g_W = R_Cp_W.transpose() * g_Cp;
           const Eigen::Vector3f pxg = p_W.cross(g_W);
-          const float Jp[8] = {g_W.x(), g_W.y(), g_W.z(), pxg.x(), pxg.y(), pxg.z(), rp, 0.f};
+          const float Jp[7] = {g_W.x(), g_W.y(), g_W.z(), pxg.x(), pxg.y(), pxg.z(), rp};
           f.Add(Jp, photo_weight * wp);
           ++sums.photometric;
         }
@@ -398,9 +439,9 @@ ModelImages BuildModel(const TsdfVolume& volume, const PinholeCamera& camera,
   m.camera = camera;
   m.raycast = Raycast(volume, camera, T_W_C_pred, p.raycast);
   if (!photometric) return m;
-  m.intensity = Intensity(m.raycast.color);
-  m.intensity_gradient = Image<Eigen::Vector2f>(camera.width, camera.height,
-                                                Eigen::Vector2f::Zero());
+  Intensity(m.raycast.color, m.intensity);
+  m.intensity_gradient =
+      Image<Eigen::Vector2f>(camera.width, camera.height, Eigen::Vector2f::Zero());
   const auto hit = [&](int u, int v) {
     return m.raycast.status.at(u, v) == uint8_t(RayStatus::kHit);
   };
@@ -419,8 +460,19 @@ bool IsFinite(const Pose3d& T) { return T.matrix().allFinite(); }
 
 }  // namespace
 
+// Buffers kept from frame to frame (the input pyramid is a few MB at 640x480).
+struct FrameTracker::Workspace {
+  std::array<InputLevel, kLevels> levels;
+  DepthImage masked_depth;
+  std::vector<std::vector<InputPoint>> bands;
+};
+
+FrameTracker::~FrameTracker() = default;
+FrameTracker::FrameTracker(FrameTracker&&) noexcept = default;
+FrameTracker& FrameTracker::operator=(FrameTracker&&) noexcept = default;
+
 FrameTracker::FrameTracker(const PinholeCamera& camera, const TrackingParams& params)
-    : camera_(camera), params_(params) {
+    : camera_(camera), params_(params), workspace_(std::make_unique<Workspace>()) {
   if (!camera.Valid()) throw std::invalid_argument("FrameTracker: invalid camera");
   if (camera.width < 4 << (kLevels - 1) || camera.height < 4 << (kLevels - 1))
     throw std::invalid_argument("FrameTracker: image too small for the pyramid");
@@ -465,16 +517,19 @@ Result<TrackingResult> FrameTracker::Track(const DepthImage& depth, const ColorI
 
   // Input pyramid.
   auto t0 = Clock::now();
-  std::array<InputLevel, kLevels> levels;
+  std::array<InputLevel, kLevels>& levels = workspace_->levels;
   levels[0].camera = camera_;
-  levels[0].depth = FilterDepth(depth, params_);
-  if (photometric) levels[0].intensity = Intensity(color);
+  FilterDepth(depth, params_, workspace_->masked_depth, levels[0].depth);
+  if (photometric) Intensity(color, levels[0].intensity);
   for (int l = 1; l < kLevels; ++l) {
     levels[l].camera = HalfCamera(levels[l - 1].camera);
-    levels[l].depth = DownsampleDepth(levels[l - 1].depth, params_.pyramid_depth_gate_m);
-    if (photometric) levels[l].intensity = DownsampleIntensity(levels[l - 1].intensity);
+    DownsampleDepth(levels[l - 1].depth, params_.pyramid_depth_gate_m, levels[l].depth);
+    if (photometric) DownsampleIntensity(levels[l - 1].intensity, levels[l].intensity);
   }
-  for (InputLevel& level : levels) ComputeVertexNormalMaps(level);
+  for (InputLevel& level : levels) {
+    if (!photometric) level.intensity = Image<float>();
+    BuildPoints(level, workspace_->bands);
+  }
   result.filter_ms = MsSince(t0);
   const auto finish = [&](std::string failure) {
     result.ok = failure.empty();
@@ -499,15 +554,19 @@ Result<TrackingResult> FrameTracker::Track(const DepthImage& depth, const ColorI
       last = BuildSystem(levels[size_t(l)], model, T_W_C.cast<float>(), T_C_W_pred, params_,
                          photometric);
       ++result.iterations;
+      ++result.level_iterations[size_t(l)];
       if (last.inliers < kMinCorrespondences) {
         result.icp_ms = MsSince(t0);
-        return finish("too few correspondences with the model (" +
-                      std::to_string(last.inliers) + " at level " + std::to_string(l) + ")");
+        return finish("too few correspondences with the model (" + std::to_string(last.inliers) +
+                      " at level " + std::to_string(l) + ")");
       }
       result.condition_number = float(NormalizedConditionNumber(last));
       // A degenerate system has no unique solution; solving it would only move the pose
-      // along the free directions, so stop here.
+      // along the free directions. Coarse levels, with few and smoothed points, may be
+      // degenerate where the full frame is not: they hand over to the next level unchanged;
+      // the finest level decides.
       if (!(result.condition_number <= params_.max_condition_number)) {
+        if (l > 0) break;
         result.icp_ms = MsSince(t0);
         return finish("degenerate geometry: condition number " +
                       std::to_string(result.condition_number) + " > " +

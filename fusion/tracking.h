@@ -6,6 +6,7 @@
 // constant-velocity prior predicts the pose. Loss is detected from the inlier ratio, the
 // residual and the conditioning of the normal equations; a lost frame must not be integrated.
 #include <array>
+#include <memory>
 #include <optional>
 #include <string>
 
@@ -19,10 +20,12 @@
 namespace voxplan {
 
 struct TrackingParams {
-  std::array<int, 3> iterations = {10, 5, 4};  // per pyramid level, finest first
-  float max_correspondence_m = 0.10f;           // projective association distance gate
-  float max_normal_angle_deg = 30.0f;
-  float huber_delta_m = 0.01f;
+  // Per pyramid level, finest first; the finest level costs 16x the coarsest and converges in
+  // 1-3 steps after the coarse ones (more did not change ATE on ICL-NUIM or 7-Scenes).
+  std::array<int, 3> iterations = {2, 5, 4};
+  float max_correspondence_m = 0.10f;  // projective association distance gate
+  float max_normal_angle_deg = 20.0f;
+  float huber_delta_m = 0.005f;
   // Colour term: cost = sum Huber(point-to-plane [m]) + weight * sum Huber(intensity in [0, 1]).
   float photometric_weight = 0.0f;  // 0: geometry only; > 0 weighs in the colour term
   float photometric_huber_delta = 0.1f;
@@ -31,17 +34,17 @@ struct TrackingParams {
   int bilateral_diameter_px = 5;
   float pyramid_depth_gate_m = 0.05f;  // neighbours averaged into a coarse pixel lie this close
   // The model is raycast at this pyramid level (0: full resolution; 1: half, a quarter the cost).
-  int model_level = 0;
-  float min_update = 1e-5f;  // a level stops iterating once the increment is smaller (rad, m)
+  int model_level = 1;
+  float min_update = 1e-4f;  // a level stops iterating once the increment is smaller (rad, m)
   bool constant_velocity = true;
   // Loss detection.
-  float min_inlier_ratio = 0.25f;      // of valid input pixels, at the finest level
-  float max_residual_rms_m = 0.02f;    // point-to-plane RMS of inliers at the end
+  float min_inlier_ratio = 0.25f;    // of valid input pixels, at the finest level
+  float max_residual_rms_m = 0.02f;  // point-to-plane RMS of inliers at the end
   // Of the 6x6 normal equations with rotation about the centroid, scaled by the spread of the
-  // points: 7-Scenes kitchen 4-23, ICL-NUIM office (walls) 76-213, a single plane > 1000.
+  // points: 7-Scenes kitchen 4-40, ICL-NUIM office (walls) up to 280, a single plane ~9000.
   float max_condition_number = 1000.f;
-  float max_motion_m = 0.3f;           // a larger jump from the prediction is a failure
-  RaycastParams raycast;  // of the model; its depth range also bounds the input depth
+  float max_motion_m = 0.3f;  // a larger jump from the prediction is a failure
+  RaycastParams raycast;      // of the model; its depth range also bounds the input depth
 };
 
 struct TrackingResult {
@@ -50,9 +53,10 @@ struct TrackingResult {
   float inlier_ratio = 0.f;
   float residual_rms_m = 0.f;
   float condition_number = 0.f;
-  int iterations = 0;      // Gauss-Newton steps over all levels
-  size_t inliers = 0;      // correspondences at the finest level
-  double track_ms = 0.0;   // everything below together
+  int iterations = 0;                               // Gauss-Newton steps over all levels
+  std::array<int, 3> level_iterations = {0, 0, 0};  // per pyramid level, finest first
+  size_t inliers = 0;                               // correspondences at the finest level
+  double track_ms = 0.0;                            // everything below together
   double filter_ms = 0.0;  // bilateral filter, pyramid, vertex and normal maps
   double raycast_ms = 0.0;
   double icp_ms = 0.0;
@@ -63,7 +67,12 @@ struct TrackingResult {
 // integrates the frame with result.T_W_C only when result.ok, then calls Accept().
 class FrameTracker {
  public:
+  // Throws std::invalid_argument for an invalid camera, one too small for the pyramid or an
+  // out-of-range model_level.
   FrameTracker(const PinholeCamera& camera, const TrackingParams& params);
+  ~FrameTracker();
+  FrameTracker(FrameTracker&&) noexcept;
+  FrameTracker& operator=(FrameTracker&&) noexcept;
   // The pose of the first frame (from the dataset, or identity).
   void Reset(const Pose3f& T_W_C);
   Result<TrackingResult> Track(const DepthImage& depth, const ColorImage& color,
@@ -77,6 +86,8 @@ class FrameTracker {
   TrackingParams params_;
   Pose3f last_T_W_C_ = Pose3f::Identity();
   std::optional<Pose3f> previous_T_W_C_;
+  struct Workspace;
+  std::unique_ptr<Workspace> workspace_;
 };
 
 }  // namespace voxplan

@@ -1,5 +1,3 @@
-#include "fusion/tracking.h"
-
 #include <gtest/gtest.h>
 
 #include <Eigen/Geometry>
@@ -9,6 +7,7 @@
 
 #include "core/parallel.h"
 #include "fusion/integrate.h"
+#include "fusion/tracking.h"
 #include "io/dataset.h"
 #include "tests/support/test_support.h"
 
@@ -20,8 +19,8 @@ using test::Plane;
 using test::Sphere;
 
 // Named bounds.
-constexpr float kMaxRotationErrorDeg = 0.2f;
-constexpr float kMaxTranslationErrorM = 0.005f;
+constexpr float kMaxRotationErrorDeg = 0.05f;
+constexpr float kMaxTranslationErrorM = 0.001f;
 constexpr float kPhotometricSlackM = 0.001f;  // colour may not worsen translation by more
 constexpr double kMaxIclAteM = 0.03;          // first 60 ICL-NUIM frames, tracked
 
@@ -71,8 +70,8 @@ ColorImage RenderTexture(const DepthImage& depth, const PinholeCamera& cam, cons
       if (z <= 0.f) continue;
       const Eigen::Vector3f p_W = T_W_C * cam.Unproject(float(u), float(v), z);
       const float k = 2.f * float(M_PI) / 0.4f;
-      const float i = 0.5f + 0.2f * std::sin(k * p_W.x()) + 0.2f * std::sin(k * p_W.y()) *
-                                                                 std::cos(k * p_W.z());
+      const float i = 0.5f + 0.2f * std::sin(k * p_W.x()) +
+                      0.2f * std::sin(k * p_W.y()) * std::cos(k * p_W.z());
       const auto c = uint8_t(std::clamp(i, 0.f, 1.f) * 255.f);
       out.at(u, v) = PackRgb(c, c, c);
     }
@@ -108,8 +107,8 @@ struct Fixture {
     integrate.max_depth_m = 5.f;
     for (int k = -2; k <= 2; ++k) {
       Pose3f T_W_C = nominal;
-      T_W_C.linear() = Eigen::AngleAxisf(0.04f * float(k), Eigen::Vector3f::UnitZ()) *
-                       T_W_C.linear();
+      T_W_C.linear() =
+          Eigen::AngleAxisf(0.04f * float(k), Eigen::Vector3f::UnitZ()) * T_W_C.linear();
       T_W_C.translation() += Eigen::Vector3f(0.05f * float(k), -0.05f * float(k), 0.f);
       const DepthImage depth = RenderScene(scene, camera, T_W_C);
       const ColorImage color = textured ? RenderTexture(depth, camera, T_W_C) : ColorImage();
@@ -138,6 +137,9 @@ TEST(FrameTracker, RecoversPerturbedPoseOnCornerScene) {
   ASSERT_TRUE(r.ok()) << r.status().message();
   EXPECT_TRUE(r->ok) << r->failure;
   EXPECT_TRUE(r->failure.empty());
+  RecordProperty("rotation_error_deg", std::to_string(RotationErrorDeg(r->T_W_C, T_W_C_true)));
+  RecordProperty("translation_error_mm",
+                 std::to_string(1000.f * TranslationError(r->T_W_C, T_W_C_true)));
   EXPECT_LT(RotationErrorDeg(r->T_W_C, T_W_C_true), kMaxRotationErrorDeg);
   EXPECT_LT(TranslationError(r->T_W_C, T_W_C_true), kMaxTranslationErrorM);
   EXPECT_GT(r->inlier_ratio, 0.5f);
@@ -184,6 +186,8 @@ TEST(FrameTracker, PhotometricTermDoesNotHurtOnTexturedScene) {
   }
   EXPECT_LT(translation_error[1], kMaxTranslationErrorM);
   EXPECT_LT(rotation_error[1], kMaxRotationErrorDeg);
+  RecordProperty("translation_error_mm_geometric", std::to_string(1000.f * translation_error[0]));
+  RecordProperty("translation_error_mm_photometric", std::to_string(1000.f * translation_error[1]));
   EXPECT_LE(translation_error[1], translation_error[0] + kPhotometricSlackM);
 }
 
@@ -197,6 +201,7 @@ TEST(FrameTracker, SinglePlaneIsDegenerate) {
   ASSERT_TRUE(r.ok());
   EXPECT_FALSE(r->ok);
   EXPECT_NE(r->failure.find("degenerate"), std::string::npos) << r->failure;
+  RecordProperty("condition_number", std::to_string(r->condition_number));
   EXPECT_GT(r->condition_number, TrackingParams{}.max_condition_number);
   // A lost frame reports the prediction.
   EXPECT_EQ(r->T_W_C.matrix(), NominalAbovePlane().matrix());
@@ -307,16 +312,15 @@ TEST(FrameTracker, IclNuimFirstFramesStayOnTrajectory) {
       }
       tracker.Accept(T_W_C);
     }
-    ASSERT_TRUE(
-        IntegrateFrame(frame->depth, frame->color, info.camera, T_W_C, {}, volume).ok());
+    ASSERT_TRUE(IntegrateFrame(frame->depth, frame->color, info.camera, T_W_C, {}, volume).ok());
     estimated.push_back(T_W_C.translation().cast<double>());
     truth.push_back(frame->T_W_C->translation());
   }
   ASSERT_GE(estimated.size(), 50u);
   EXPECT_EQ(lost, 0);
   Eigen::Matrix3Xd a(3, estimated.size()), b(3, truth.size());
-  for (size_t k = 0; k < estimated.size(); ++k) a.col(Eigen::Index(k)) = estimated[k],
-                                                 b.col(Eigen::Index(k)) = truth[k];
+  for (size_t k = 0; k < estimated.size(); ++k)
+    a.col(Eigen::Index(k)) = estimated[k], b.col(Eigen::Index(k)) = truth[k];
   const Eigen::Matrix4d S = Eigen::umeyama(a, b, false);
   const Eigen::Matrix3Xd aligned =
       (S.topLeftCorner<3, 3>() * a).colwise() + S.topRightCorner<3, 1>();
