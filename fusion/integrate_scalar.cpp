@@ -37,7 +37,8 @@ void IntegrateBlockScalar(const FrameView& f, BlockIndex index, TsdfBlock& block
         const float old_t = float(block.tsdf[i]) * (1.0f / kTsdfScale);
         const float old_w = float(block.weight[i]) * (1.0f / kWeightScale);
         const float sum_w = old_w + w_obs;
-        const float new_t = (old_t * old_w + tsdf * w_obs) / sum_w;
+        const float inv_sum_w = 1.0f / sum_w;  // one division for TSDF and the three colours
+        const float new_t = (old_t * old_w + tsdf * w_obs) * inv_sum_w;
         const float new_w = std::min(sum_w, f.max_weight);
         block.tsdf[i] =
             int16_t(std::nearbyint(std::min(std::max(new_t, -1.0f), 1.0f) * kTsdfScale));
@@ -48,7 +49,7 @@ void IntegrateBlockScalar(const FrameView& f, BlockIndex index, TsdfBlock& block
           const float obs[3] = {float(c & 0xff), float((c >> 8) & 0xff), float((c >> 16) & 0xff)};
           uint8_t* ch[3] = {&block.r[i], &block.g[i], &block.b[i]};
           for (int k = 0; k < 3; ++k)
-            *ch[k] = uint8_t(std::nearbyint((float(*ch[k]) * old_w + obs[k] * w_obs) / sum_w));
+            *ch[k] = uint8_t(std::nearbyint((float(*ch[k]) * old_w + obs[k] * w_obs) * inv_sum_w));
         }
       }
     }

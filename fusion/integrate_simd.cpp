@@ -89,8 +89,9 @@ VOXPLAN_AVX2 void IntegrateBlockSimd(const FrameView& f, BlockIndex index, TsdfB
       const __m256 old_w =
           _mm256_mul_ps(_mm256_cvtepi32_ps(_mm256_cvtepu16_epi32(old_w16)), inv_w_scale);
       const __m256 sum_w = _mm256_add_ps(old_w, w_obs);
-      const __m256 new_t = _mm256_div_ps(
-          _mm256_add_ps(_mm256_mul_ps(old_t, old_w), _mm256_mul_ps(tsdf, w_obs)), sum_w);
+      const __m256 inv_sum_w = _mm256_div_ps(one, sum_w);  // one division for all four
+      const __m256 new_t = _mm256_mul_ps(
+          _mm256_add_ps(_mm256_mul_ps(old_t, old_w), _mm256_mul_ps(tsdf, w_obs)), inv_sum_w);
       const __m256 new_w = _mm256_min_ps(sum_w, Splat(f.max_weight));
       const __m256i t32 = _mm256_cvtps_epi32(
           _mm256_mul_ps(_mm256_min_ps(_mm256_max_ps(new_t, minus_one), one), Splat(kTsdfScale)));
@@ -108,20 +109,20 @@ VOXPLAN_AVX2 void IntegrateBlockSimd(const FrameView& f, BlockIndex index, TsdfB
       const __m256i c =
           _mm256_mask_i32gather_epi32(_mm256_setzero_si256(), reinterpret_cast<const int*>(f.color),
                                       pixel, _mm256_castps_si256(cmask), 4);
+      // Colour: blend 8 new bytes into the old ones where the lane is in the band.
+      const __m128i cmask16 = PackI32ToI16(_mm256_castps_si256(cmask));
+      const __m128i cmask8 = _mm_packs_epi16(cmask16, cmask16);
       uint8_t* channels[3] = {&block.r[i], &block.g[i], &block.b[i]};
-      alignas(32) int32_t out[8];
-      alignas(32) int32_t keep[8];
-      _mm256_store_si256(reinterpret_cast<__m256i*>(keep), _mm256_castps_si256(cmask));
       for (int k = 0; k < 3; ++k) {
         const __m256 obs =
             _mm256_cvtepi32_ps(_mm256_and_si256(_mm256_srli_epi32(c, 8 * k), byte_mask));
         const __m128i old8 = _mm_loadl_epi64(reinterpret_cast<const __m128i*>(channels[k]));
         const __m256 old_c = _mm256_cvtepi32_ps(_mm256_cvtepu8_epi32(old8));
-        const __m256 new_c = _mm256_div_ps(
-            _mm256_add_ps(_mm256_mul_ps(old_c, old_w), _mm256_mul_ps(obs, w_obs)), sum_w);
-        _mm256_store_si256(reinterpret_cast<__m256i*>(out), _mm256_cvtps_epi32(new_c));
-        for (int x = 0; x < kBlockSide; ++x)
-          if (keep[x]) channels[k][x] = uint8_t(out[x]);
+        const __m256 new_c = _mm256_mul_ps(
+            _mm256_add_ps(_mm256_mul_ps(old_c, old_w), _mm256_mul_ps(obs, w_obs)), inv_sum_w);
+        const __m128i new16 = PackI32ToU16(_mm256_cvtps_epi32(new_c));
+        _mm_storel_epi64(reinterpret_cast<__m128i*>(channels[k]),
+                         _mm_blendv_epi8(old8, _mm_packus_epi16(new16, new16), cmask8));
       }
     }
   }
