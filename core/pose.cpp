@@ -1,5 +1,6 @@
 #include "core/pose.h"
 
+#include <cassert>
 #include <cmath>
 
 namespace voxplan {
@@ -32,6 +33,22 @@ Result<Pose3d> PoseFromTranslationQuaternion(const Eigen::Vector3d& t, double qx
   pose.linear() = q.toRotationMatrix();
   pose.translation() = t;
   return pose;
+}
+
+Pose3f LookAt(const Eigen::Vector3f& eye_W, const Eigen::Vector3f& target_W,
+              const Eigen::Vector3f& up_W) {
+  assert((target_W - eye_W).norm() > 0.0f);
+  const Eigen::Vector3f z_W = (target_W - eye_W).normalized();  // forward
+  Eigen::Vector3f x_W = z_W.cross(up_W);                        // right
+  if (x_W.norm() < 1e-6f) x_W = z_W.cross(Eigen::Vector3f::UnitY());
+  x_W.normalize();
+  const Eigen::Vector3f y_W = z_W.cross(x_W);  // down in the image
+  Pose3f T_W_C = Pose3f::Identity();
+  T_W_C.linear().col(0) = x_W;
+  T_W_C.linear().col(1) = y_W;
+  T_W_C.linear().col(2) = z_W;
+  T_W_C.translation() = eye_W;
+  return T_W_C;
 }
 
 }  // namespace voxplan

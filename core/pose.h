@@ -20,4 +20,9 @@ Status ValidatePoseMatrix(const Eigen::Matrix4d& m);
 Result<Pose3d> PoseFromTranslationQuaternion(const Eigen::Vector3d& t, double qx, double qy,
                                              double qz, double qw, bool* renormalised = nullptr);
 
+// T_W_C of a camera at `eye_W` looking at `target_W`, image up along `up_W` (x stays
+// horizontal). Looking straight along `up_W` falls back to world Y as up. eye != target.
+Pose3f LookAt(const Eigen::Vector3f& eye_W, const Eigen::Vector3f& target_W,
+              const Eigen::Vector3f& up_W = Eigen::Vector3f::UnitZ());
+
 }  // namespace voxplan

@@ -15,22 +15,6 @@ float Radians(float deg) { return deg * std::numbers::pi_v<float> / 180.0f; }
 
 }  // namespace
 
-Pose3f LookAt(const Eigen::Vector3f& eye_W, const Eigen::Vector3f& target_W,
-              const Eigen::Vector3f& up_W) {
-  assert((target_W - eye_W).norm() > 0.0f);
-  const Eigen::Vector3f z_W = (target_W - eye_W).normalized();  // forward
-  Eigen::Vector3f x_W = z_W.cross(up_W);                        // right
-  if (x_W.norm() < 1e-6f) x_W = z_W.cross(Eigen::Vector3f::UnitY());
-  x_W.normalize();
-  const Eigen::Vector3f y_W = z_W.cross(x_W);  // down in the image
-  Pose3f T_W_C = Pose3f::Identity();
-  T_W_C.linear().col(0) = x_W;
-  T_W_C.linear().col(1) = y_W;
-  T_W_C.linear().col(2) = z_W;
-  T_W_C.translation() = eye_W;
-  return T_W_C;
-}
-
 std::vector<Pose3f> OrbitPoses(const Eigen::Vector3f& centre_W, float radius_m, float height_m,
                                int n, const Eigen::Vector3f& up_W) {
   const Eigen::Vector3f up = up_W.normalized();

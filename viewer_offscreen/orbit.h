@@ -9,11 +9,6 @@
 
 namespace voxplan {
 
-// T_W_C of a camera at `eye_W` looking at `target_W`, image up along `up_W` (x stays
-// horizontal). Looking straight along `up_W` falls back to world Y as up. eye != target.
-Pose3f LookAt(const Eigen::Vector3f& eye_W, const Eigen::Vector3f& target_W,
-              const Eigen::Vector3f& up_W = Eigen::Vector3f::UnitZ());
-
 // n cameras on the circle of `radius_m` around `centre_W` in the plane normal to `up_W`,
 // `height_m` above it along `up_W`, each looking at the centre with the image upright. With
 // the Z-up default, view k sits at angle 2 pi k / n from +X, counter-clockwise seen from above.

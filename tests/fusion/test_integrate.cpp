@@ -14,7 +14,6 @@
 namespace voxplan {
 namespace {
 
-using test::LookAt;
 using test::TestCamera;
 
 constexpr float kVoxel = 0.02f;

@@ -28,7 +28,7 @@ Sequence MakeSequence() {
   const test::Plane floor{Eigen::Vector3f(0, 0, 1), 0.0f};
   for (int k = 0; k < 5; ++k) {
     const float a = 0.4f + float(k) * 0.5f;
-    const Pose3f T_W_C = test::LookAt(Eigen::Vector3f(1.4f * std::cos(a), 1.4f * std::sin(a), 0.9f),
+    const Pose3f T_W_C = LookAt(Eigen::Vector3f(1.4f * std::cos(a), 1.4f * std::sin(a), 0.9f),
                                       Eigen::Vector3f(0, 0, 0.3f));
     DepthImage ds = test::RenderDepth(sphere, seq.cam, T_W_C);
     const DepthImage df = test::RenderDepth(floor, seq.cam, T_W_C);

@@ -10,7 +10,6 @@
 namespace voxplan {
 namespace {
 
-using test::LookAt;
 using test::TestCamera;
 
 // Float ray-triangle intersection against the exact analytic depth, a few metres away.

@@ -99,19 +99,4 @@ DepthImage RenderDepth(const Box& s, const PinholeCamera& cam, const Pose3f& T_W
   return Render(cam, T_W_C, [&](auto& o, auto& d) { return HitBox(s, o, d); });
 }
 
-Pose3f LookAt(const Eigen::Vector3f& eye, const Eigen::Vector3f& target,
-              const Eigen::Vector3f& up) {
-  const Eigen::Vector3f z = (target - eye).normalized();
-  Eigen::Vector3f x = z.cross(up);
-  if (x.norm() < 1e-6f) x = z.cross(Eigen::Vector3f::UnitX());
-  x.normalize();
-  const Eigen::Vector3f y = z.cross(x);  // image y points down
-  Pose3f T_W_C = Pose3f::Identity();
-  T_W_C.linear().col(0) = x;
-  T_W_C.linear().col(1) = y;
-  T_W_C.linear().col(2) = z;
-  T_W_C.translation() = eye;
-  return T_W_C;
-}
-
 }  // namespace voxplan::test

@@ -48,8 +48,7 @@ DepthImage RenderDepth(const Plane& s, const PinholeCamera& cam, const Pose3f& T
 DepthImage RenderDepth(const Sphere& s, const PinholeCamera& cam, const Pose3f& T_W_C);
 DepthImage RenderDepth(const Box& s, const PinholeCamera& cam, const Pose3f& T_W_C);
 
-// Camera at `eye` looking at `target` with world up `up` (OpenCV axes: y down in the image).
-Pose3f LookAt(const Eigen::Vector3f& eye, const Eigen::Vector3f& target,
-              const Eigen::Vector3f& up = Eigen::Vector3f::UnitZ());
+using voxplan::LookAt;  // core/pose.h; tests may still write test::LookAt
+
 
 }  // namespace voxplan::test
