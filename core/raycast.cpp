@@ -10,7 +10,8 @@
 namespace voxplan {
 namespace {
 
-constexpr int kRangeCell = 8;  // pixels per side of a range-image cell
+constexpr int kRangeCell = 8;    // pixels per side of a range-image cell
+constexpr int kSurfaceCell = 4;  // pixels per side of a surface-range cell
 constexpr int kTile = 16;      // pixels per side of one parallel work item
 constexpr int kLanes = 4;      // rays a worker marches interleaved
 // Step as a fraction of the stored distance: the nearest voxel's centre can be up to 0.87 voxel
@@ -30,8 +31,10 @@ constexpr float kNaN = std::numeric_limits<float>::quiet_NaN();
 struct RangeImage {
   int cols = 0, rows = 0;
   std::vector<float> z_min, z_max;  // z_min > z_max where no block projects
-  // The nearest depth of blocks holding an observed negative voxel: a surface crossing can
-  // only end in such a block, so rays that can hit start just in front of it.
+  // Per cell of kSurfaceCell^2 pixels, the nearest depth of the cubes of observed negative
+  // voxels: a surface crossing can only end in such a cube, so rays that can hit start just in
+  // front of it.
+  int surface_cols = 0, surface_rows = 0;
   std::vector<float> surface_z_min;
 };
 
@@ -47,6 +50,33 @@ bool HasNegativeVoxel(const TsdfBlock& block, uint16_t min_weight_fixed) {
   return count > 0;
 }
 
+// Per brick of kBrickSide^3 voxels of a block (x fastest), the least camera depth of the centres
+// of its observed negative voxels, or infinity. Voxel (x, y, z) of the block has its centre at
+// depth z0 + x * dx + y * dy + z * dz.
+constexpr int kBrickSide = 2;
+constexpr int kBricksPerSide = kBlockSide / kBrickSide;
+constexpr int kBricks = kBricksPerSide * kBricksPerSide * kBricksPerSide;
+void NearestNegativeDepths(const TsdfBlock& block, uint16_t min_weight_fixed, float z0, float dx,
+                           float dy, float dz, float* brick_depth) {
+  constexpr float kInf = std::numeric_limits<float>::infinity();
+  for (int i = 0; i < kBricks; ++i) brick_depth[i] = kInf;
+  float x_depth[kBlockSide];
+  for (int x = 0; x < kBlockSide; ++x) x_depth[x] = float(x) * dx;
+  for (int row = 0; row < kBlockSide * kBlockSide; ++row) {
+    const int y = row & kBlockMask, z = row >> kBlockShift;
+    const float row_depth = z0 + float(z) * dz + float(y) * dy;
+    const int16_t* tsdf = block.tsdf + row * kBlockSide;
+    const uint16_t* weight = block.weight + row * kBlockSide;
+    float* bricks = brick_depth + (z / kBrickSide) * kBricksPerSide * kBricksPerSide +
+                    (y / kBrickSide) * kBricksPerSide;
+    for (int x = 0; x < kBlockSide; ++x) {
+      const bool negative = tsdf[x] < 0 && weight[x] >= min_weight_fixed;
+      float& d = bricks[x / kBrickSide];
+      d = std::min(d, negative ? row_depth + x_depth[x] : kInf);
+    }
+  }
+}
+
 // The depth where marching starts: a voxel before min_depth, so that a surface just beyond it
 // is approached from its positive side (crossings in front of min_depth are not reported).
 float MarchStart(const TsdfVolume& volume, const RaycastParams& params) {
@@ -58,7 +88,10 @@ RangeImage BuildRangeImage(const TsdfVolume& volume, const PinholeCamera& camera
   RangeImage range;
   range.cols = (camera.width + kRangeCell - 1) / kRangeCell;
   range.rows = (camera.height + kRangeCell - 1) / kRangeCell;
+  range.surface_cols = (camera.width + kSurfaceCell - 1) / kSurfaceCell;
+  range.surface_rows = (camera.height + kSurfaceCell - 1) / kSurfaceCell;
   const size_t num_cells = size_t(range.cols) * size_t(range.rows);
+  const size_t num_surface_cells = size_t(range.surface_cols) * size_t(range.surface_rows);
   constexpr float kInf = std::numeric_limits<float>::infinity();
 
   std::vector<BlockIndex> blocks;
@@ -84,13 +117,24 @@ RangeImage BuildRangeImage(const TsdfVolume& volume, const PinholeCamera& camera
   const float z_near = MarchStart(volume, params), z_far = params.max_depth_m;
   // Pixels are admitted half a pixel beyond the projected box to absorb rounding.
   constexpr float kPixelMargin = 0.5f;
+  // One voxel along each block axis, in the camera frame; half a voxel cube's extent in depth
+  // (a sample inside a voxel's cube lies at most that far in front of its centre); the radius
+  // of the sphere around a brick.
+  const float voxel_m = volume.voxel_size_m();
+  const Eigen::Vector3f voxel_x = R_C_W.col(0) * voxel_m, voxel_y = R_C_W.col(1) * voxel_m,
+                        voxel_z = R_C_W.col(2) * voxel_m;
+  const float cube_half_depth =
+      0.5f * (std::abs(voxel_x.z()) + std::abs(voxel_y.z()) + std::abs(voxel_z.z()));
+  const float brick_radius = 0.5f * std::sqrt(3.f) * float(kBrickSide) * voxel_m;
+  const float u_max_px = float(camera.width - 1), v_max_px = float(camera.height - 1);
 
   ParallelFor(num_chunks, 1, [&](size_t begin, size_t end) {
+    float brick_depth[kBricks];
     for (size_t c = begin; c < end; ++c) {
       Chunk& chunk = chunks[c];
       chunk.z_min.assign(num_cells, kInf);
       chunk.z_max.assign(num_cells, -kInf);
-      chunk.surface_z_min.assign(num_cells, kInf);
+      chunk.surface_z_min.assign(num_surface_cells, kInf);
       const size_t first = blocks.size() * c / num_chunks;
       const size_t last = blocks.size() * (c + 1) / num_chunks;
       for (size_t k = first; k < last; ++k) {
@@ -130,32 +174,71 @@ RangeImage BuildRangeImage(const TsdfVolume& volume, const PinholeCamera& camera
         }
         if (!(u_min <= u_max) || !(v_min <= v_max)) continue;
         const float u_lo = std::max(std::ceil(u_min - kPixelMargin), 0.f);
-        const float u_hi = std::min(std::floor(u_max + kPixelMargin), float(camera.width - 1));
+        const float u_hi = std::min(std::floor(u_max + kPixelMargin), u_max_px);
         const float v_lo = std::max(std::ceil(v_min - kPixelMargin), 0.f);
-        const float v_hi = std::min(std::floor(v_max + kPixelMargin), float(camera.height - 1));
+        const float v_hi = std::min(std::floor(v_max + kPixelMargin), v_max_px);
         if (u_lo > u_hi || v_lo > v_hi) continue;
         const float z_lo = std::max(box_z_min, z_near), z_hi = box_z_max;
-        const bool surface = HasNegativeVoxel(*block_data[k], min_weight_fixed);
         for (int cy = int(v_lo) / kRangeCell; cy <= int(v_hi) / kRangeCell; ++cy)
           for (int cx = int(u_lo) / kRangeCell; cx <= int(u_hi) / kRangeCell; ++cx) {
             const size_t cell = size_t(cy) * size_t(range.cols) + size_t(cx);
             chunk.z_min[cell] = std::min(chunk.z_min[cell], z_lo);
             chunk.z_max[cell] = std::max(chunk.z_max[cell], z_hi);
-            if (surface) chunk.surface_z_min[cell] = std::min(chunk.surface_z_min[cell], z_lo);
           }
+        if (!HasNegativeVoxel(*block_data[k], min_weight_fixed)) continue;
+        // Each brick holding a negative voxel splats the nearest depth of those voxels' cubes
+        // over the pixels its bounding sphere can project to (the whole block's where the
+        // sphere reaches z_near).
+        const Eigen::Vector3f centre0_C = p0_C + 0.5f * (voxel_x + voxel_y + voxel_z);
+        NearestNegativeDepths(*block_data[k], min_weight_fixed, centre0_C.z(), voxel_x.z(),
+                              voxel_y.z(), voxel_z.z(), brick_depth);
+        const Eigen::Vector3f brick0_C =
+            p0_C + (0.5f * float(kBrickSide)) * (voxel_x + voxel_y + voxel_z);
+        for (int i = 0; i < kBricks; ++i) {
+          if (!(brick_depth[i] < kInf)) continue;
+          const float surface_z = std::max(brick_depth[i] - cube_half_depth, z_lo);
+          const int bx = i % kBricksPerSide, by = (i / kBricksPerSide) % kBricksPerSide,
+                    bz = i / (kBricksPerSide * kBricksPerSide);
+          const Eigen::Vector3f c_C =
+              brick0_C + float(kBrickSide) * (float(bx) * voxel_x + float(by) * voxel_y +
+                                              float(bz) * voxel_z);
+          float bu_lo = u_lo, bu_hi = u_hi, bv_lo = v_lo, bv_hi = v_hi;
+          const float z_front = c_C.z() - brick_radius;
+          if (z_front > z_near) {
+            // A point of the sphere projects within r (1 + |x_c / z_c|) / (z_c - r) of the
+            // centre's projection, in normalised image units.
+            const float inv_z = 1.f / c_C.z(), inv_front = 1.f / z_front;
+            const float xn = c_C.x() * inv_z, yn = c_C.y() * inv_z;
+            const float ru = std::abs(camera.fx) * brick_radius * (1.f + std::abs(xn)) * inv_front;
+            const float rv = std::abs(camera.fy) * brick_radius * (1.f + std::abs(yn)) * inv_front;
+            const float u_c = camera.fx * xn + camera.cx, v_c = camera.fy * yn + camera.cy;
+            bu_lo = std::max(std::ceil(u_c - ru - kPixelMargin), u_lo);
+            bu_hi = std::min(std::floor(u_c + ru + kPixelMargin), u_hi);
+            bv_lo = std::max(std::ceil(v_c - rv - kPixelMargin), v_lo);
+            bv_hi = std::min(std::floor(v_c + rv + kPixelMargin), v_hi);
+            if (bu_lo > bu_hi || bv_lo > bv_hi) continue;
+          }
+          for (int cy = int(bv_lo) / kSurfaceCell; cy <= int(bv_hi) / kSurfaceCell; ++cy)
+            for (int cx = int(bu_lo) / kSurfaceCell; cx <= int(bu_hi) / kSurfaceCell; ++cx) {
+              float& z = chunk.surface_z_min[size_t(cy) * size_t(range.surface_cols) + size_t(cx)];
+              z = std::min(z, surface_z);
+            }
+        }
       }
     }
   });
 
   range.z_min.assign(num_cells, kInf);
   range.z_max.assign(num_cells, -kInf);
-  range.surface_z_min.assign(num_cells, kInf);
-  for (const Chunk& chunk : chunks)
+  range.surface_z_min.assign(num_surface_cells, kInf);
+  for (const Chunk& chunk : chunks) {
     for (size_t i = 0; i < num_cells; ++i) {
       range.z_min[i] = std::min(range.z_min[i], chunk.z_min[i]);
       range.z_max[i] = std::max(range.z_max[i], chunk.z_max[i]);
-      range.surface_z_min[i] = std::min(range.surface_z_min[i], chunk.surface_z_min[i]);
     }
+    for (size_t i = 0; i < num_surface_cells; ++i)
+      range.surface_z_min[i] = std::min(range.surface_z_min[i], chunk.surface_z_min[i]);
+  }
   return range;
 }
 
@@ -474,10 +557,12 @@ class RayCaster {
     }
     result->status = RayStatus::kHit;
     result->z = z;
-    const float norm = gradient.norm();
-    result->normal_W =
-        norm > 0.f ? Eigen::Vector3f(gradient / norm) : Eigen::Vector3f(kNaN, kNaN, kNaN);
-    result->color = CellColor(cell);
+    if (params_.with_normals) {
+      const float norm = gradient.norm();
+      result->normal_W =
+          norm > 0.f ? Eigen::Vector3f(gradient / norm) : Eigen::Vector3f(kNaN, kNaN, kNaN);
+    }
+    if (params_.with_color) result->color = CellColor(cell);
     return true;
   }
 
@@ -580,8 +665,10 @@ void Raycast(const TsdfVolume& volume, const PinholeCamera& camera, const Pose3f
             const float z_end = std::min(range.z_max[cell], params.max_depth_m);
             // Start two voxels in front of the nearest block that can end a crossing, so the
             // sample before the crossing is still taken.
-            const float z_surface =
-                std::max(range.surface_z_min[cell] - 2.f * volume.voxel_size_m(), z_all);
+            const size_t surface_cell = size_t(v / kSurfaceCell) * size_t(range.surface_cols) +
+                                        size_t(u / kSurfaceCell);
+            const float z_surface = std::max(
+                range.surface_z_min[surface_cell] - 2.f * volume.voxel_size_m(), z_all);
             if (z_all <= z_end) {
               const Eigen::Vector3f dir_C((float(u) - camera.cx) / camera.fx,
                                           (float(v) - camera.cy) / camera.fy, 1.f);

@@ -21,6 +21,9 @@ struct RaycastParams {
   // A ray entering a surface from behind (negative to positive) stops there as kFree, as
   // tracking wants; renders from outside a room march on to see its inside.
   bool stop_at_back_faces = true;
+  // Outputs a caller may not need: without them the colour (or normal) image stays 0 (NaN).
+  bool with_color = true;
+  bool with_normals = true;
 };
 
 enum class RayStatus : uint8_t {
@@ -32,8 +35,8 @@ enum class RayStatus : uint8_t {
 struct RaycastImages {
   DepthImage depth;                 // z along the optical axis, metres; 0 unless kHit
   Image<Eigen::Vector3f> vertex_W;  // hit point in world; NaN unless kHit
-  Image<Eigen::Vector3f> normal_W;  // unit outward normal in world; NaN unless kHit
-  ColorImage color;                 // interpolated voxel colour; 0 unless kHit
+  Image<Eigen::Vector3f> normal_W;  // unit outward normal in world; NaN unless kHit (or off)
+  ColorImage color;                 // interpolated voxel colour; 0 unless kHit (or off)
   Image<uint8_t> status;            // RayStatus
 };
 

@@ -3,6 +3,7 @@
 #include <Eigen/Cholesky>
 #include <Eigen/Eigenvalues>
 #include <chrono>
+#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <memory>
@@ -85,46 +86,61 @@ PinholeCamera LevelCamera(const PinholeCamera& c, int level) {
   return out;
 }
 
+// Calls fn(v_begin, v_end) on bands of rows in parallel; each row is written by one task only.
+template <typename Fn>
+void ForRowBands(int height, const Fn& fn) {
+  const size_t num_bands = size_t((height + kRowsPerBand - 1) / kRowsPerBand);
+  ParallelFor(num_bands, 1, [&](size_t b0, size_t b1) {
+    fn(int(b0) * kRowsPerBand, std::min(int(b1) * kRowsPerBand, height));
+  });
+}
+
 // Edge-preserving smoothing of valid depth; invalid pixels (0) stay invalid. A 0 neighbour is
 // metres away in depth, so its range weight vanishes and it does not pull valid pixels down.
 void FilterDepth(const DepthImage& depth, const TrackingParams& p, DepthImage& masked,
                  DepthImage& out) {
-  Reshape(masked, depth.width, depth.height, 0.f);
-  for (size_t i = 0; i < depth.data.size(); ++i) {
-    const float d = depth.data[i];
-    if (d >= p.raycast.min_depth_m && d <= p.raycast.max_depth_m) masked.data[i] = d;
-  }
-  if (p.bilateral_diameter_px <= 0) {
-    out = masked;
-    return;
-  }
+  const bool filter = p.bilateral_diameter_px > 0;
+  DepthImage& valid = filter ? masked : out;
+  Reshape(valid, depth.width, depth.height, 0.f);
+  const float lo = p.raycast.min_depth_m, hi = p.raycast.max_depth_m;
+  ForRowBands(depth.height, [&](int v0, int v1) {
+    for (size_t i = size_t(v0) * size_t(depth.width); i < size_t(v1) * size_t(depth.width); ++i) {
+      const float d = depth.data[i];
+      valid.data[i] = d >= lo && d <= hi ? d : 0.f;
+    }
+  });
+  if (!filter) return;
   Reshape(out, depth.width, depth.height, 0.f);
   const cv::Mat src(masked.height, masked.width, CV_32F, masked.data.data());
   cv::Mat dst(out.height, out.width, CV_32F, out.data.data());
   cv::bilateralFilter(src, dst, p.bilateral_diameter_px, p.bilateral_sigma_depth_m,
                       p.bilateral_sigma_space_px, cv::BORDER_REPLICATE);
-  for (size_t i = 0; i < out.data.size(); ++i)
-    if (masked.data[i] == 0.f || !std::isfinite(out.data[i])) out.data[i] = 0.f;
+  ForRowBands(depth.height, [&](int v0, int v1) {
+    for (size_t i = size_t(v0) * size_t(depth.width); i < size_t(v1) * size_t(depth.width); ++i)
+      if (masked.data[i] == 0.f || !std::isfinite(out.data[i])) out.data[i] = 0.f;
+  });
 }
 
 // Average of the valid pixels of each 2x2 cell that lie within `gate` of the cell's nearest
 // valid depth: no averaging across depth edges, so no flying pixels.
 void DownsampleDepth(const DepthImage& d, float gate, DepthImage& out) {
   Reshape(out, d.width / 2, d.height / 2, 0.f);
-  for (int v = 0; v < out.height; ++v)
-    for (int u = 0; u < out.width; ++u) {
-      const float z[4] = {d.at(2 * u, 2 * v), d.at(2 * u + 1, 2 * v), d.at(2 * u, 2 * v + 1),
-                          d.at(2 * u + 1, 2 * v + 1)};
-      float ref = std::numeric_limits<float>::infinity();
-      for (float zi : z)
-        if (zi > 0.f) ref = std::min(ref, zi);
-      if (!std::isfinite(ref)) continue;
-      float sum = 0.f;
-      int n = 0;
-      for (float zi : z)
-        if (zi > 0.f && zi - ref <= gate) sum += zi, ++n;
-      out.at(u, v) = sum / float(n);
-    }
+  ForRowBands(out.height, [&](int v0, int v1) {
+    for (int v = v0; v < v1; ++v)
+      for (int u = 0; u < out.width; ++u) {
+        const float z[4] = {d.at(2 * u, 2 * v), d.at(2 * u + 1, 2 * v), d.at(2 * u, 2 * v + 1),
+                            d.at(2 * u + 1, 2 * v + 1)};
+        float ref = std::numeric_limits<float>::infinity();
+        for (float zi : z)
+          if (zi > 0.f) ref = std::min(ref, zi);
+        if (!std::isfinite(ref)) continue;
+        float sum = 0.f;
+        int n = 0;
+        for (float zi : z)
+          if (zi > 0.f && zi - ref <= gate) sum += zi, ++n;
+        out.at(u, v) = sum / float(n);
+      }
+  });
 }
 
 float Luma(uint32_t c) {
@@ -147,7 +163,9 @@ void DownsampleIntensity(const Image<float>& in, Image<float>& out) {
 // Points with normals from the cross product of central differences, facing the camera. Depth
 // edges (a neighbour off the surface) leave a pixel out. Bands of rows run in parallel and are
 // concatenated in order, so the points stay row-major whatever the thread count.
-void BuildPoints(InputLevel& level, std::vector<std::vector<InputPoint>>& bands) {
+// With stride > 1 only every stride-th pixel of every stride-th row becomes a point (and counts
+// as valid); its normal still comes from its direct neighbours.
+void BuildPoints(InputLevel& level, int stride, std::vector<std::vector<InputPoint>>& bands) {
   const PinholeCamera& cam = level.camera;
   const DepthImage& d = level.depth;
   const bool has_intensity = !level.intensity.empty();
@@ -161,8 +179,8 @@ void BuildPoints(InputLevel& level, std::vector<std::vector<InputPoint>>& bands)
       out.clear();
       const int v_begin = int(b) * kRowsPerBand;
       const int v_end = std::min(v_begin + kRowsPerBand, d.height);
-      for (int v = v_begin; v < v_end; ++v)
-        for (int u = 0; u < d.width; ++u) {
+      for (int v = (v_begin + stride - 1) / stride * stride; v < v_end; v += stride)
+        for (int u = 0; u < d.width; u += stride) {
           const float z = d.at(u, v);
           if (z <= 0.f) continue;
           ++band_valid[b];
@@ -341,7 +359,11 @@ NormalEquations BuildSystem(const InputLevel& in, const ModelImages& model, cons
   const Eigen::Matrix3f R_W_C = T_W_C.linear();
   const Eigen::Vector3f t_W_C = T_W_C.translation();
   const Eigen::Matrix3f R_Cp_W = T_C_W_pred.linear();
-  const Eigen::Vector3f t_Cp_W = T_C_W_pred.translation();
+  // Input camera straight to the predicted (model) camera: the world point is only needed once
+  // a pixel is hit.
+  const Pose3f T_Cp_C = T_C_W_pred * T_W_C;
+  const Eigen::Matrix3f R_Cp_C = T_Cp_C.linear();
+  const Eigen::Vector3f t_Cp_C = T_Cp_C.translation();
   const PinholeCamera& mc = model.camera;
   const float photo_weight = p.photometric_weight;
   const float max_x = float(mc.width) - 0.5f, max_y = float(mc.height) - 0.5f;
@@ -357,8 +379,7 @@ NormalEquations BuildSystem(const InputLevel& in, const ModelImages& model, cons
         const size_t run_end = std::min(run + kPointsPerFloatRun, end);
         for (size_t i = run; i < run_end; ++i) {
           const InputPoint& pt = in.points[i];
-          const Eigen::Vector3f p_W = R_W_C * pt.p_C + t_W_C;
-          const Eigen::Vector3f p_Cp = R_Cp_W * p_W + t_Cp_W;
+          const Eigen::Vector3f p_Cp = R_Cp_C * pt.p_C + t_Cp_C;
           if (p_Cp.z() <= 0.f) continue;
           const float inv_z = 1.f / p_Cp.z();
           const float x = mc.fx * p_Cp.x() * inv_z + mc.cx, y = mc.fy * p_Cp.y() * inv_z + mc.cy;
@@ -367,6 +388,7 @@ NormalEquations BuildSystem(const InputLevel& in, const ModelImages& model, cons
           const int mu = int(x + 0.5f), mv = int(y + 0.5f);
           const Eigen::Vector3f& q_W = model.raycast.vertex_W.at(mu, mv);
           if (!std::isfinite(q_W.x())) continue;
+          const Eigen::Vector3f p_W = R_W_C * pt.p_C + t_W_C;
           const Eigen::Vector3f diff = p_W - q_W;
           if (diff.squaredNorm() > max_dist2) continue;
           const Eigen::Vector3f& n_W = model.raycast.normal_W.at(mu, mv);
@@ -478,6 +500,8 @@ FrameTracker::FrameTracker(const PinholeCamera& camera, const TrackingParams& pa
     throw std::invalid_argument("FrameTracker: image too small for the pyramid");
   if (params.model_level < 0 || params.model_level >= kLevels)
     throw std::invalid_argument("FrameTracker: model_level must be in [0, 3)");
+  if (params.finest_level_stride < 1)
+    throw std::invalid_argument("FrameTracker: finest_level_stride must be at least 1");
 }
 
 void FrameTracker::Reset(const Pose3f& T_W_C) {
@@ -526,9 +550,10 @@ Result<TrackingResult> FrameTracker::Track(const DepthImage& depth, const ColorI
     DownsampleDepth(levels[l - 1].depth, params_.pyramid_depth_gate_m, levels[l].depth);
     if (photometric) DownsampleIntensity(levels[l - 1].intensity, levels[l].intensity);
   }
-  for (InputLevel& level : levels) {
+  for (int l = 0; l < kLevels; ++l) {
+    InputLevel& level = levels[size_t(l)];
     if (!photometric) level.intensity = Image<float>();
-    BuildPoints(level, workspace_->bands);
+    BuildPoints(level, l == 0 ? params_.finest_level_stride : 1, workspace_->bands);
   }
   result.filter_ms = MsSince(t0);
   const auto finish = [&](std::string failure) {
@@ -578,7 +603,9 @@ Result<TrackingResult> FrameTracker::Track(const DepthImage& depth, const ColorI
         return finish("non-finite Gauss-Newton update");
       }
       T_W_C = ExpSe3(xi) * T_W_C;
-      if (xi.norm() < params_.min_update) break;
+      // A coarse level only has to bring the pose into the next level's reach: its pixels are
+      // 2^l times larger, and so is the increment at which it stops.
+      if (xi.norm() < params_.min_update * float(1 << l)) break;
     }
   }
   result.icp_ms = MsSince(t0);

@@ -32,6 +32,7 @@ Command AddInfoCommand(CLI::App& app);
 Command AddEvalCommand(CLI::App& app);
 Command AddDemoCommand(CLI::App& app);
 Command AddRenderCommand(CLI::App& app);
+Command AddBenchCommand(CLI::App& app);
 
 // Prints `error: <message>` on stderr and returns exit_code, so callers can `return Fail(...)`.
 int Fail(const std::string& message, int exit_code = kExitFailure);

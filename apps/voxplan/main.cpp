@@ -19,7 +19,8 @@ int main(int argc, char** argv) {
   });
 
   std::vector<Command> commands = {AddFuseCommand(app), AddMeshCommand(app), AddInfoCommand(app),
-                                   AddEvalCommand(app), AddDemoCommand(app), AddRenderCommand(app)};
+                                   AddEvalCommand(app), AddDemoCommand(app), AddRenderCommand(app),
+                                   AddBenchCommand(app)};
   try {
     app.parse(argc, argv);
   } catch (const CLI::CallForHelp& e) {

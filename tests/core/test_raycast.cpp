@@ -17,7 +17,6 @@ namespace voxplan {
 namespace {
 
 using test::Box;
-using test::LookAt;
 using test::Plane;
 using test::Sphere;
 using test::TestCamera;
@@ -358,6 +357,27 @@ TEST(Raycast, OneAndTwoThreadsGiveIdenticalBytes) {
   Raycast(volume, cam, T_W_C, {}, reused);
   EXPECT_TRUE(same(one.depth, reused.depth));
   EXPECT_TRUE(same(one.normal_W, reused.normal_W));
+}
+
+TEST(Raycast, ColourAndNormalsCanBeSkipped) {
+  const Sphere sphere{Eigen::Vector3f(0.f, 0.f, 0.f), 0.3f};
+  const TsdfVolume volume =
+      FillExact([&](const Eigen::Vector3f& p) { return sphere.Sdf(p); },
+                Eigen::Vector3f::Constant(-0.45f), Eigen::Vector3f::Constant(0.45f));
+  const PinholeCamera cam = TestCamera(80, 60);
+  const Pose3f T_W_C = LookAt(Eigen::Vector3f(0.9f, 0.3f, 0.2f), Eigen::Vector3f::Zero());
+  const RaycastImages full = Raycast(volume, cam, T_W_C);
+  RaycastParams params;
+  params.with_color = false;
+  params.with_normals = false;
+  const RaycastImages bare = Raycast(volume, cam, T_W_C, params);
+  ASSERT_GT(Count(full, RayStatus::kHit), 1000u);
+  for (size_t i = 0; i < full.status.data.size(); ++i) {
+    EXPECT_EQ(bare.status.data[i], full.status.data[i]);
+    EXPECT_EQ(bare.depth.data[i], full.depth.data[i]);
+    EXPECT_EQ(bare.color.data[i], 0u);
+    EXPECT_TRUE(bare.normal_W.data[i].array().isNaN().all());
+  }
 }
 
 TEST(Raycast, InvalidInputsGiveEmptyOrUnobservedImages) {

@@ -79,12 +79,12 @@ ColorImage RenderTexture(const DepthImage& depth, const PinholeCamera& cam, cons
 }
 
 Pose3f Nominal() {
-  return test::LookAt(Eigen::Vector3f(1.8f, 1.6f, 1.4f), Eigen::Vector3f(-0.3f, -0.3f, 0.2f));
+  return LookAt(Eigen::Vector3f(1.8f, 1.6f, 1.4f), Eigen::Vector3f(-0.3f, -0.3f, 0.2f));
 }
 // Looking steeply down at the floor, where the TSDF of a plane is clean (no grazing rays), so
 // only the geometry is degenerate.
 Pose3f NominalAbovePlane() {
-  return test::LookAt(Eigen::Vector3f(0.4f, 0.3f, 1.5f), Eigen::Vector3f::Zero());
+  return LookAt(Eigen::Vector3f(0.4f, 0.3f, 1.5f), Eigen::Vector3f::Zero());
 }
 
 // 3 degrees about a skew axis and 5 cm, in the camera frame.
@@ -147,6 +147,28 @@ TEST(FrameTracker, RecoversPerturbedPoseOnCornerScene) {
   EXPECT_GT(r->iterations, 0);
   // The start was off by the perturbation itself.
   EXPECT_GT(TranslationError(Nominal(), T_W_C_true), 0.04f);
+}
+
+// The finest level on every pixel or on a subsampled grid: both recover the pose.
+TEST(FrameTracker, FinestLevelStrideKeepsAccuracy) {
+  const Scene scene = CornerScene();
+  Fixture f(scene, false);
+  const Pose3f T_W_C_true = Nominal() * Perturbation();
+  const DepthImage depth = RenderScene(scene, f.camera, T_W_C_true);
+  for (int stride : {1, 2, 3}) {
+    TrackingParams params;
+    params.finest_level_stride = stride;
+    FrameTracker tracker(f.camera, params);
+    tracker.Reset(Nominal());
+    const Result<TrackingResult> r = tracker.Track(depth, ColorImage(), f.volume);
+    ASSERT_TRUE(r.ok() && r->ok) << "stride " << stride;
+    EXPECT_LT(RotationErrorDeg(r->T_W_C, T_W_C_true), kMaxRotationErrorDeg) << "stride " << stride;
+    EXPECT_LT(TranslationError(r->T_W_C, T_W_C_true), kMaxTranslationErrorM) << "stride " << stride;
+    EXPECT_GT(r->inlier_ratio, 0.5f) << "stride " << stride;
+  }
+  TrackingParams bad;
+  bad.finest_level_stride = 0;
+  EXPECT_THROW(FrameTracker(f.camera, bad), std::invalid_argument);
 }
 
 TEST(FrameTracker, DeterministicAcrossThreadCounts) {
