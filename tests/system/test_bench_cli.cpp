@@ -16,6 +16,7 @@
 #include "core/block_pool.h"
 #include "core/volume.h"
 #include "tests/support/test_support.h"
+#include "tests/system/cli_runner.h"
 
 namespace voxplan {
 namespace {
@@ -23,52 +24,10 @@ namespace {
 namespace fs = std::filesystem;
 using nlohmann::json;
 
-struct RunResult {
-  int exit_code = -1;
-  std::string out, err;
-  json last_json;  // the last stdout line, parsed; null when it is not JSON
-};
-
-std::string ReadAll(const fs::path& path) {
-  std::ifstream in(path, std::ios::binary);
-  std::stringstream s;
-  s << in.rdbuf();
-  return s.str();
-}
-
-std::string Quote(const std::string& arg) {
-  std::string q = "'";
-  for (char c : arg) q += c == '\'' ? std::string("'\\''") : std::string(1, c);
-  return q + "'";
-}
-
-// env_prefix: shell variable assignments for the run, e.g. "PYTHONHOME=/nonexistent".
-RunResult RunCli(const std::vector<std::string>& args, const std::string& env_prefix = "") {
-  const test::TempDir capture("voxplan-bench-capture");
-  const fs::path out = capture / "stdout", err = capture / "stderr";
-  std::string command = env_prefix.empty() ? std::string() : env_prefix + " ";
-  command.append(Quote(VOXPLAN_CLI_PATH));
-  // Appended piecewise: `" " + Quote(...)` trips a GCC 12 -Wrestrict false positive.
-  for (const std::string& a : args) command.append(" ").append(Quote(a));
-  command.append(" >").append(Quote(out.string()));
-  command.append(" 2>").append(Quote(err.string())).append(" </dev/null");
-  const int status = std::system(command.c_str());
-  RunResult r;
-  r.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-  r.out = ReadAll(out);
-  r.err = ReadAll(err);
-  std::string line, last;
-  std::istringstream lines(r.out);
-  while (std::getline(lines, line))
-    if (!line.empty()) last = line;
-  r.last_json = json::parse(last, nullptr, /*allow_exceptions=*/false);
-  if (r.last_json.is_discarded()) r.last_json = nullptr;
-  return r;
-}
-
-std::string Describe(const RunResult& r) {
-  return "exit " + std::to_string(r.exit_code) + "\nstdout:\n" + r.out + "\nstderr:\n" + r.err;
-}
+using test::Describe;
+using test::ReadAll;
+using test::RunCli;
+using test::RunResult;
 
 fs::path IclDir() { return test::SharedDataDir() / "rgbd" / "iclnuim_office_traj0"; }
 
