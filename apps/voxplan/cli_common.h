@@ -95,6 +95,14 @@ double PeakRssMb();  // MiB, from getrusage
 // (mesh_vertices, mesh_triangles, mesh_ms) every command that builds them reports alike.
 void AddMapStats(nlohmann::json& j, const TsdfVolume& volume);
 void AddMeshStats(nlohmann::json& j, const Mesh& mesh, double mesh_ms);
+
+// The frame list `fuse --frame-list` writes and bench/open3d_fusion.py reads: one entry per
+// integrated frame (image paths, row-major camera-to-world), then the camera and parameters.
+nlohmann::json FrameListEntry(const std::string& depth_path, const std::string& color_path,
+                              const Eigen::Matrix4d& T_W_C);
+nlohmann::json FrameList(const PinholeCamera& camera, double depth_scale, double voxel_size_m,
+                         double trunc_m, double min_depth_m, double max_depth_m,
+                         nlohmann::json frames);
 double RoundTo(double value, int decimals);
 // A float as the double with the same shortest decimal form (0.02f -> 0.02, not 0.0199999...).
 double FloatValue(float value);

@@ -482,26 +482,13 @@ int RunBench(const BenchOptions& o, BenchMode mode) {
   if (o.vs_open3d) {
     json frames = json::array();
     for (const FrameRecord& r : records) {
-      const Eigen::Matrix<double, 4, 4, Eigen::RowMajor> T = r.T_W_C.matrix();
-      frames.push_back({{"depth", r.depth_path},
-                        {"color", r.color_path},
-                        {"T_W_C", std::vector<double>(T.data(), T.data() + 16)}});
+      frames.push_back(FrameListEntry(r.depth_path, r.color_path, r.T_W_C.matrix()));
     }
     // The layout of `fuse --frame-list`, plus a VBG capacity sized from voxplan's map: VBG
     // allocates and touches all of it up front, so a guess would decide its RSS.
-    json list = {{"width", info.camera.width},
-                 {"height", info.camera.height},
-                 {"fx", FloatValue(info.camera.fx)},
-                 {"fy", FloatValue(info.camera.fy)},
-                 {"cx", FloatValue(info.camera.cx)},
-                 {"cy", FloatValue(info.camera.cy)},
-                 {"depth_scale", info.depth_scale},
-                 {"voxel_size_m", o.voxel_size_m},
-                 {"trunc_m", o.trunc_m},
-                 {"min_depth_m", o.min_depth_m},
-                 {"max_depth_m", o.max_depth_m},
-                 {"vbg_block_count", std::max<size_t>(1024, rows.back().blocks * 5 / 4)},
-                 {"frames", frames}};
+    json list = FrameList(info.camera, info.depth_scale, o.voxel_size_m, o.trunc_m, o.min_depth_m,
+                          o.max_depth_m, frames);
+    list["vbg_block_count"] = std::max<size_t>(1024, rows.back().blocks * 5 / 4);
     TempFrameList list_file;
     if (Status s = list_file.Write(list); !s.ok()) return Fail(s.message());
     std::string poses_arg;

@@ -195,10 +195,8 @@ int RunFuse(const FuseOptions& o) {
       trajectory_t.push_back(frame->timestamp);
       trajectory.push_back(*T_W_C);
       if (!o.frame_list_path.empty()) {
-        const Eigen::Matrix<double, 4, 4, Eigen::RowMajor> T = T_W_C->matrix().cast<double>();
-        frame_list.push_back({{"depth", frame->depth_path},
-                              {"color", frame->color_path},
-                              {"T_W_C", std::vector<double>(T.data(), T.data() + 16)}});
+        frame_list.push_back(
+            FrameListEntry(frame->depth_path, frame->color_path, T_W_C->matrix().cast<double>()));
       }
     }
     progress.Update(k + 1);
@@ -241,18 +239,8 @@ int RunFuse(const FuseOptions& o) {
   if (!o.frame_list_path.empty()) {
     // Exactly the frames integrated, with the parameters, for reference runs of other
     // pipelines (bench/open3d_fusion.py) on identical input.
-    nlohmann::json list = {{"width", info.camera.width},
-                           {"height", info.camera.height},
-                           {"fx", FloatValue(info.camera.fx)},
-                           {"fy", FloatValue(info.camera.fy)},
-                           {"cx", FloatValue(info.camera.cx)},
-                           {"cy", FloatValue(info.camera.cy)},
-                           {"depth_scale", info.depth_scale},
-                           {"voxel_size_m", o.voxel_size_m},
-                           {"trunc_m", o.trunc_m},
-                           {"min_depth_m", o.min_depth_m},
-                           {"max_depth_m", o.max_depth_m},
-                           {"frames", frame_list}};
+    const nlohmann::json list = FrameList(info.camera, info.depth_scale, o.voxel_size_m, o.trunc_m,
+                                          o.min_depth_m, o.max_depth_m, frame_list);
     if (Status s = WriteJsonFile(list, o.frame_list_path); !s.ok())
       return Fail(MessageNaming(s, o.frame_list_path));
   }

@@ -23,32 +23,13 @@ using test::TestCamera;
 
 constexpr float kVoxel = 0.01f;
 constexpr float kTrunc = 4 * kVoxel;
-constexpr uint8_t kR = 10, kG = 20, kB = 30;
+constexpr uint8_t kR = test::kExactRgb[0], kG = test::kExactRgb[1], kB = test::kExactRgb[2];
 
 using Sdf = std::function<float(const Eigen::Vector3f&)>;
 
-// Every block of [lo, hi] within the band (or all of them with `all_blocks`) gets the exact
-// truncated SDF at its voxel centres, weight 1 and a constant colour.
 TsdfVolume FillExact(const Sdf& sdf, const Eigen::Vector3f& lo, const Eigen::Vector3f& hi,
                      bool all_blocks = false) {
-  TsdfVolume volume({kVoxel, kTrunc});
-  const float block = kVoxel * kBlockSide;
-  const BlockIndex b0 = BlockAt(lo, block), b1 = BlockAt(hi, block);
-  for (int z = b0.z; z <= b1.z; ++z)
-    for (int y = b0.y; y <= b1.y; ++y)
-      for (int x = b0.x; x <= b1.x; ++x) {
-        const BlockIndex b{x, y, z};
-        const Eigen::Vector3f centre = BlockOrigin(b, block) + Eigen::Vector3f::Constant(block / 2);
-        if (!all_blocks && std::abs(sdf(centre)) > block + kTrunc) continue;
-        TsdfBlock& data = volume.FindOrAllocate(b);
-        for (int i = 0; i < kBlockVoxels; ++i) {
-          data.tsdf[i] =
-              EncodeTsdf(sdf(VoxelCenter(GlobalOf(b, VoxelOfLinear(i)), kVoxel)) / kTrunc);
-          data.weight[i] = EncodeWeight(1.0f);
-          data.r[i] = kR, data.g[i] = kG, data.b[i] = kB;
-        }
-      }
-  return volume;
+  return test::FillExactSdf(sdf, {kVoxel, kTrunc}, lo, hi, all_blocks);
 }
 
 // True when every pixel within `radius` has an analytic hit: away from silhouettes.

@@ -11,30 +11,10 @@
 namespace voxplan {
 namespace {
 
-// Writes an exact SDF into every voxel of the blocks within `band_m` of the surface.
 template <typename Sdf>
 TsdfVolume FillExact(const Sdf& sdf, float voxel, float trunc, const Eigen::Vector3f& lo,
                      const Eigen::Vector3f& hi) {
-  TsdfVolume volume({voxel, trunc});
-  const float block = voxel * kBlockSide;
-  const BlockIndex b0 = BlockAt(lo, block), b1 = BlockAt(hi, block);
-  for (int z = b0.z; z <= b1.z; ++z)
-    for (int y = b0.y; y <= b1.y; ++y)
-      for (int x = b0.x; x <= b1.x; ++x) {
-        const BlockIndex b{x, y, z};
-        const Eigen::Vector3f centre = BlockOrigin(b, block) + Eigen::Vector3f::Constant(block / 2);
-        if (std::abs(sdf(centre)) > block + trunc) continue;
-        TsdfBlock& data = volume.FindOrAllocate(b);
-        for (int i = 0; i < kBlockVoxels; ++i) {
-          const float d = sdf(VoxelCenter(GlobalOf(b, VoxelOfLinear(i)), voxel));
-          data.tsdf[i] = EncodeTsdf(d / trunc);
-          data.weight[i] = EncodeWeight(1.0f);
-          data.r[i] = 10;
-          data.g[i] = 20;
-          data.b[i] = 30;
-        }
-      }
-  return volume;
+  return test::FillExactSdf(sdf, {voxel, trunc}, lo, hi);
 }
 
 // Every undirected edge used by exactly two triangles, in opposite directions.

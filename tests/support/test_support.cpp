@@ -99,4 +99,26 @@ DepthImage RenderDepth(const Box& s, const PinholeCamera& cam, const Pose3f& T_W
   return Render(cam, T_W_C, [&](auto& o, auto& d) { return HitBox(s, o, d); });
 }
 
+TsdfVolume FillExactSdf(const std::function<float(const Eigen::Vector3f&)>& sdf,
+                        const VolumeParams& params, const Eigen::Vector3f& lo,
+                        const Eigen::Vector3f& hi, bool all_blocks) {
+  TsdfVolume volume(params);
+  const float voxel = params.voxel_size_m, trunc = params.trunc_m, block = voxel * kBlockSide;
+  const BlockIndex b0 = BlockAt(lo, block), b1 = BlockAt(hi, block);
+  for (int z = b0.z; z <= b1.z; ++z)
+    for (int y = b0.y; y <= b1.y; ++y)
+      for (int x = b0.x; x <= b1.x; ++x) {
+        const BlockIndex b{x, y, z};
+        const Eigen::Vector3f centre = BlockOrigin(b, block) + Eigen::Vector3f::Constant(block / 2);
+        if (!all_blocks && std::abs(sdf(centre)) > block + trunc) continue;
+        TsdfBlock& data = volume.FindOrAllocate(b);
+        for (int i = 0; i < kBlockVoxels; ++i) {
+          data.tsdf[i] = EncodeTsdf(sdf(VoxelCenter(GlobalOf(b, VoxelOfLinear(i)), voxel)) / trunc);
+          data.weight[i] = EncodeWeight(1.0f);
+          data.r[i] = kExactRgb[0], data.g[i] = kExactRgb[1], data.b[i] = kExactRgb[2];
+        }
+      }
+  return volume;
+}
+
 }  // namespace voxplan::test

@@ -3,11 +3,13 @@
 // temporary folders and the path of ../shared/data.
 #include <Eigen/Core>
 #include <filesystem>
+#include <functional>
 #include <string>
 
 #include "core/camera.h"
 #include "core/image.h"
 #include "core/pose.h"
+#include "core/volume.h"
 
 namespace voxplan::test {
 
@@ -48,7 +50,13 @@ DepthImage RenderDepth(const Plane& s, const PinholeCamera& cam, const Pose3f& T
 DepthImage RenderDepth(const Sphere& s, const PinholeCamera& cam, const Pose3f& T_W_C);
 DepthImage RenderDepth(const Box& s, const PinholeCamera& cam, const Pose3f& T_W_C);
 
-using voxplan::LookAt;  // core/pose.h; tests may still write test::LookAt
+// A volume holding the exact truncated SDF `sdf` at the voxel centres of every block of
+// [lo, hi] near the surface (or all of them with `all_blocks`), weight 1, colour kExactRgb.
+inline constexpr uint8_t kExactRgb[3] = {10, 20, 30};
+TsdfVolume FillExactSdf(const std::function<float(const Eigen::Vector3f&)>& sdf,
+                        const VolumeParams& params, const Eigen::Vector3f& lo,
+                        const Eigen::Vector3f& hi, bool all_blocks = false);
 
+using voxplan::LookAt;  // core/pose.h; tests may still write test::LookAt
 
 }  // namespace voxplan::test
