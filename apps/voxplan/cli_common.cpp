@@ -19,6 +19,13 @@ namespace voxplan::cli {
 
 namespace fs = std::filesystem;
 
+int RunParsed(const std::vector<Command>& commands) {
+  for (const Command& command : commands) {
+    if (command.app->parsed()) return command.run();
+  }
+  return Fail("no subcommand given", kExitUsage);
+}
+
 int Fail(const std::string& message, int exit_code) {
   std::cerr << "error: " << message << std::endl;
   return exit_code;

@@ -33,6 +33,15 @@ Command AddEvalCommand(CLI::App& app);
 Command AddDemoCommand(CLI::App& app);
 Command AddRenderCommand(CLI::App& app);
 Command AddBenchCommand(CLI::App& app);
+Command AddSimCommand(CLI::App& app);
+// Subcommands that live in their own files, added to a parent command above.
+Command AddSimSceneCommand(CLI::App& sim);     // sim scene   (cmd_sim_scene.cpp)
+Command AddSimRenderCommand(CLI::App& sim);    // sim render  (cmd_sim_render.cpp)
+Command AddBenchMapsCommand(CLI::App& bench);  // bench maps  (cmd_bench_maps.cpp)
+std::vector<Command> AddEvalSimCommands(
+    CLI::App& eval);  // eval of simulated runs (cmd_eval_sim.cpp)
+// Runs the parsed one of `commands`; fails with a usage error when none was.
+int RunParsed(const std::vector<Command>& commands);
 
 // Prints `error: <message>` on stderr and returns exit_code, so callers can `return Fail(...)`.
 int Fail(const std::string& message, int exit_code = kExitFailure);

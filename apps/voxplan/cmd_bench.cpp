@@ -719,7 +719,9 @@ Command AddBenchCommand(CLI::App& app) {
   AddBenchOptions(p->raycast_app, p->raycast);
   p->mesh_app = bench->add_subcommand("mesh", "Fuse once per thread count (untimed), time meshing");
   AddBenchOptions(p->mesh_app, p->mesh);
-  return {bench, [p] {
+  const Command maps = AddBenchMapsCommand(*bench);
+  return {bench, [p, maps] {
+            if (maps.app->parsed()) return maps.run();
             if (p->raycast_app->parsed()) return RunBench(p->raycast, BenchMode::kRaycast);
             if (p->mesh_app->parsed()) return RunBench(p->mesh, BenchMode::kMesh);
             return RunBench(p->fusion, BenchMode::kFusion);

@@ -158,7 +158,11 @@ Command AddEvalCommand(CLI::App& app) {
   traj->add_option("--max-dt", t->max_dt_s, "Largest timestamp difference to associate (s)")
       ->check(NonNegative())
       ->capture_default_str();
-  return {eval, [traj, o, t] {
+  const std::vector<Command> sim_evals = AddEvalSimCommands(*eval);
+  return {eval, [traj, o, t, sim_evals] {
+            for (const Command& c : sim_evals) {
+              if (c.app->parsed()) return c.run();
+            }
             if (traj->parsed()) return RunEvalTrajectory(*t);
             return RunEvalMesh(*o);
           }};

@@ -18,9 +18,9 @@ int main(int argc, char** argv) {
     return "error: " + std::string(e.what()) + "\nRun with --help for more information.\n";
   });
 
-  std::vector<Command> commands = {AddFuseCommand(app), AddMeshCommand(app), AddInfoCommand(app),
-                                   AddEvalCommand(app), AddDemoCommand(app), AddRenderCommand(app),
-                                   AddBenchCommand(app)};
+  std::vector<Command> commands = {AddFuseCommand(app),  AddMeshCommand(app), AddInfoCommand(app),
+                                   AddEvalCommand(app),  AddDemoCommand(app), AddRenderCommand(app),
+                                   AddBenchCommand(app), AddSimCommand(app)};
   try {
     app.parse(argc, argv);
   } catch (const CLI::CallForHelp& e) {
@@ -35,12 +35,9 @@ int main(int argc, char** argv) {
   }
 
   try {
-    for (const Command& command : commands) {
-      if (command.app->parsed()) return command.run();
-    }
+    return RunParsed(commands);
   } catch (const std::exception& e) {
     // Libraries only throw on invalid construction; arguments are checked before that.
     return Fail(e.what());
   }
-  return Fail("no command given", kExitUsage);
 }
