@@ -1,19 +1,24 @@
 #include "core/raycast.h"
 
 #include <algorithm>
+#include <bit>
 #include <cmath>
 #include <limits>
 #include <vector>
 
 #include "core/parallel.h"
 
+#if defined(__SSE2__)
+#include <emmintrin.h>
+#endif
+
 namespace voxplan {
 namespace {
 
 constexpr int kRangeCell = 8;    // pixels per side of a range-image cell
 constexpr int kSurfaceCell = 4;  // pixels per side of a surface-range cell
-constexpr int kTile = 16;      // pixels per side of one parallel work item
-constexpr int kLanes = 4;      // rays a worker marches interleaved
+constexpr int kTile = 16;        // pixels per side of one parallel work item
+constexpr int kLanes = 4;        // rays a worker marches interleaved
 // Step as a fraction of the stored distance: the nearest voxel's centre can be up to 0.87 voxel
 // from the sample, and the negative band behind a surface is what catches an overshoot.
 constexpr float kStepScale = 0.9f;
@@ -42,39 +47,47 @@ struct Chunk {
   std::vector<float> z_min, z_max, surface_z_min;
 };
 
-// Whether a block holds an observed voxel behind a surface (negative distance).
-bool HasNegativeVoxel(const TsdfBlock& block, uint16_t min_weight_fixed) {
-  int count = 0;  // branch-free, so the loop vectorises
-  for (int i = 0; i < kBlockVoxels; ++i)
-    count += int(block.tsdf[i] < 0) & int(block.weight[i] >= min_weight_fixed);
-  return count > 0;
-}
-
-// Per brick of kBrickSide^3 voxels of a block (x fastest), the least camera depth of the centres
-// of its observed negative voxels, or infinity. Voxel (x, y, z) of the block has its centre at
-// depth z0 + x * dx + y * dy + z * dz.
+// Bricks of kBrickSide^3 voxels: the unit at which observed negative voxels (behind a surface)
+// are splatted into the surface range image. kBrickSide = 2 gives 64 bricks, one bit each.
 constexpr int kBrickSide = 2;
 constexpr int kBricksPerSide = kBlockSide / kBrickSide;
 constexpr int kBricks = kBricksPerSide * kBricksPerSide * kBricksPerSide;
-void NearestNegativeDepths(const TsdfBlock& block, uint16_t min_weight_fixed, float z0, float dx,
-                           float dy, float dz, float* brick_depth) {
-  constexpr float kInf = std::numeric_limits<float>::infinity();
-  for (int i = 0; i < kBricks; ++i) brick_depth[i] = kInf;
-  float x_depth[kBlockSide];
-  for (int x = 0; x < kBlockSide; ++x) x_depth[x] = float(x) * dx;
+static_assert(kBricks == 64);
+
+// Bit (bx + 4 by + 16 bz) set when brick (bx, by, bz) holds an observed voxel behind a surface
+// (negative distance). Depends on the block only, not the camera, and is two compares and a
+// movemask per x-row of voxels.
+uint64_t NegativeBrickMask(const TsdfBlock& block, uint16_t min_weight_fixed) {
+  uint64_t mask = 0;
+#if defined(__SSE2__)
+  const __m128i zero = _mm_setzero_si128();
+  // Unsigned weight >= min as a signed compare: flip the sign bits of both sides.
+  const __m128i flip = _mm_set1_epi16(int16_t(0x8000));
+  const __m128i min_minus_one = _mm_set1_epi16(int16_t((min_weight_fixed - 1) ^ 0x8000));
+#endif
   for (int row = 0; row < kBlockSide * kBlockSide; ++row) {
-    const int y = row & kBlockMask, z = row >> kBlockShift;
-    const float row_depth = z0 + float(z) * dz + float(y) * dy;
     const int16_t* tsdf = block.tsdf + row * kBlockSide;
     const uint16_t* weight = block.weight + row * kBlockSide;
-    float* bricks = brick_depth + (z / kBrickSide) * kBricksPerSide * kBricksPerSide +
-                    (y / kBrickSide) * kBricksPerSide;
-    for (int x = 0; x < kBlockSide; ++x) {
-      const bool negative = tsdf[x] < 0 && weight[x] >= min_weight_fixed;
-      float& d = bricks[x / kBrickSide];
-      d = std::min(d, negative ? row_depth + x_depth[x] : kInf);
-    }
+#if defined(__SSE2__)
+    const __m128i t = _mm_loadu_si128(reinterpret_cast<const __m128i*>(tsdf));
+    const __m128i w = _mm_loadu_si128(reinterpret_cast<const __m128i*>(weight));
+    const __m128i negative = _mm_and_si128(_mm_cmplt_epi16(t, zero),
+                                           _mm_cmpgt_epi16(_mm_xor_si128(w, flip), min_minus_one));
+    const unsigned bits = unsigned(_mm_movemask_epi8(_mm_packs_epi16(negative, zero)));
+#else
+    unsigned bits = 0;
+    for (int x = 0; x < kBlockSide; ++x)
+      bits |= unsigned(tsdf[x] < 0 && weight[x] >= min_weight_fixed) << x;
+#endif
+    if (!bits) continue;
+    const unsigned pairs = (bits | (bits >> 1)) & 0x55u;  // bit 2k: voxel 2k or 2k + 1
+    const unsigned bricks_x =
+        (pairs & 1u) | ((pairs >> 1) & 2u) | ((pairs >> 2) & 4u) | ((pairs >> 3) & 8u);
+    const int y = row & kBlockMask, z = row >> kBlockShift;
+    mask |= uint64_t(bricks_x) << (kBricksPerSide * (y / kBrickSide) +
+                                   kBricksPerSide * kBricksPerSide * (z / kBrickSide));
   }
+  return mask;
 }
 
 // The depth where marching starts: a voxel before min_depth, so that a surface just beyond it
@@ -129,7 +142,6 @@ RangeImage BuildRangeImage(const TsdfVolume& volume, const PinholeCamera& camera
   const float u_max_px = float(camera.width - 1), v_max_px = float(camera.height - 1);
 
   ParallelFor(num_chunks, 1, [&](size_t begin, size_t end) {
-    float brick_depth[kBricks];
     for (size_t c = begin; c < end; ++c) {
       Chunk& chunk = chunks[c];
       chunk.z_min.assign(num_cells, kInf);
@@ -185,23 +197,22 @@ RangeImage BuildRangeImage(const TsdfVolume& volume, const PinholeCamera& camera
             chunk.z_min[cell] = std::min(chunk.z_min[cell], z_lo);
             chunk.z_max[cell] = std::max(chunk.z_max[cell], z_hi);
           }
-        if (!HasNegativeVoxel(*block_data[k], min_weight_fixed)) continue;
-        // Each brick holding a negative voxel splats the nearest depth of those voxels' cubes
-        // over the pixels its bounding sphere can project to (the whole block's where the
-        // sphere reaches z_near).
-        const Eigen::Vector3f centre0_C = p0_C + 0.5f * (voxel_x + voxel_y + voxel_z);
-        NearestNegativeDepths(*block_data[k], min_weight_fixed, centre0_C.z(), voxel_x.z(),
-                              voxel_y.z(), voxel_z.z(), brick_depth);
+        uint64_t bricks = NegativeBrickMask(*block_data[k], min_weight_fixed);
+        if (!bricks) continue;
+        // Each brick holding a negative voxel splats a lower bound of the depth of those
+        // voxels' cubes over the pixels its bounding sphere can project to (the whole block's
+        // where the sphere reaches z_near). A 2-voxel brick's voxel centres lie within one
+        // cube_half_depth of its centre in depth, and their cubes one more.
         const Eigen::Vector3f brick0_C =
             p0_C + (0.5f * float(kBrickSide)) * (voxel_x + voxel_y + voxel_z);
-        for (int i = 0; i < kBricks; ++i) {
-          if (!(brick_depth[i] < kInf)) continue;
-          const float surface_z = std::max(brick_depth[i] - cube_half_depth, z_lo);
+        for (; bricks; bricks &= bricks - 1) {
+          const int i = std::countr_zero(bricks);
           const int bx = i % kBricksPerSide, by = (i / kBricksPerSide) % kBricksPerSide,
                     bz = i / (kBricksPerSide * kBricksPerSide);
           const Eigen::Vector3f c_C =
-              brick0_C + float(kBrickSide) * (float(bx) * voxel_x + float(by) * voxel_y +
-                                              float(bz) * voxel_z);
+              brick0_C +
+              float(kBrickSide) * (float(bx) * voxel_x + float(by) * voxel_y + float(bz) * voxel_z);
+          const float surface_z = std::max(c_C.z() - 2.f * cube_half_depth, z_lo);
           float bu_lo = u_lo, bu_hi = u_hi, bv_lo = v_lo, bv_hi = v_hi;
           const float z_front = c_C.z() - brick_radius;
           if (z_front > z_near) {
@@ -381,6 +392,14 @@ class Sampler {
   uint32_t min_weight_fixed_;
 };
 
+// A pixel whose ray has a depth range to march.
+struct RayTask {
+  size_t pixel;
+  int u, v;
+  float z_begin, z_end;
+  float z_restart;  // >= 0: on a miss, march again from here
+};
+
 struct RayResult {
   RayStatus status = RayStatus::kUnobserved;
   float z = 0.f;
@@ -413,12 +432,12 @@ uint32_t CellColor(const Cell& cell) {
 // and overlap their memory latency. The ray is p(z) = origin + z * dir_W, with dir_W the
 // camera ray scaled to unit optical depth, so z is the depth itself.
 struct Ray {
-  Eigen::Vector3f dir_W, inv_dir;
+  Eigen::Vector3f dir_W;
   float z = 0.f, z_end = 0.f;
-  float voxel_z = 0.f;                  // one voxel along the ray, in depth units
-  float step_scale_z = 0.f;             // stored fixed-point TSDF to a step in depth units
-  bool have_prev = false;               // previous sample observed, nothing unobserved since
-  Eigen::Vector3f origin_vox, dir_vox;  // the ray in voxel units: p = origin + z * dir
+  float voxel_z = 0.f;       // one voxel along the ray, in depth units
+  float step_scale_z = 0.f;  // stored fixed-point TSDF to a step in depth units
+  bool have_prev = false;    // previous sample observed, nothing unobserved since
+  Eigen::Vector3f dir_vox;   // the ray in voxel units: p = origin_vox + z * dir_vox
   BlockIndex block_index{kMaxBlockCoord + 1, 0, 0};  // the last block this ray sampled
   const TsdfBlock* block = nullptr;
   float prev_z = 0.f;
@@ -431,21 +450,20 @@ struct Ray {
 class RayCaster {
  public:
   RayCaster(const TsdfVolume& volume, const RaycastParams& params, const Eigen::Vector3f& origin_W)
-      : sampler_(volume, params), params_(params), origin_W_(origin_W) {}
+      : sampler_(volume, params),
+        params_(params),
+        origin_W_(origin_W),
+        origin_vox_(origin_W * sampler_.inv_voxel()),
+        step_scale_(kStepScale * volume.trunc_m() / kTsdfScale) {}
 
   void Start(const Eigen::Vector3f& dir_W, float z_begin, float z_end, Ray* ray) const {
-    const float dir_norm = dir_W.norm();
+    const float inv_norm = 1.f / std::sqrt(dir_W.squaredNorm());
     ray->dir_W = dir_W;
-    constexpr float kFar = 1e30f;  // 1 / 0 without infinities (0 * inf would be NaN)
-    ray->inv_dir = Eigen::Vector3f(dir_W.x() != 0.f ? 1.f / dir_W.x() : kFar,
-                                   dir_W.y() != 0.f ? 1.f / dir_W.y() : kFar,
-                                   dir_W.z() != 0.f ? 1.f / dir_W.z() : kFar);
     ray->z = z_begin;
     ray->z_end = z_end;
-    ray->voxel_z = sampler_.voxel_m() / dir_norm;
-    ray->step_scale_z = kStepScale * sampler_.trunc_m() / (kTsdfScale * dir_norm);
+    ray->voxel_z = sampler_.voxel_m() * inv_norm;
+    ray->step_scale_z = step_scale_ * inv_norm;
     ray->have_prev = false;
-    ray->origin_vox = origin_W_ * sampler_.inv_voxel();
     ray->dir_vox = dir_W * sampler_.inv_voxel();
     ray->block_index = BlockIndex{kMaxBlockCoord + 1, 0, 0};
     ray->result = RayResult{};
@@ -454,7 +472,7 @@ class RayCaster {
   // Takes one sample; true when the ray is finished and ray->result final.
   bool Step(Ray& ray) {
     if (!(ray.z <= ray.z_end)) return true;
-    const Eigen::Vector3f p = ray.origin_vox + ray.z * ray.dir_vox;
+    const Eigen::Vector3f p = origin_vox_ + ray.z * ray.dir_vox;
     const GlobalVoxelIndex g{FloorToInt(p.x()), FloorToInt(p.y()), FloorToInt(p.z())};
     const BlockIndex b = BlockOf(g);
     // Each ray keeps its own last block: interleaved rays would evict a shared one.
@@ -468,8 +486,10 @@ class RayCaster {
       const float block_m = sampler_.voxel_m() * kBlockSide;
       float z_exit = std::numeric_limits<float>::infinity();
       for (int a = 0; a < 3; ++a) {
-        const int32_t face = (&b.x)[a] + (ray.dir_W[a] >= 0.f ? 1 : 0);
-        z_exit = std::min(z_exit, (float(face) * block_m - origin_W_[a]) * ray.inv_dir[a]);
+        const float d = ray.dir_W[a];
+        if (d == 0.f) continue;  // never leaves through this axis' faces
+        const int32_t face = (&b.x)[a] + (d > 0.f ? 1 : 0);
+        z_exit = std::min(z_exit, (float(face) * block_m - origin_W_[a]) / d);
       }
       ray.z = std::max(z_exit, ray.z) + 0.01f * ray.voxel_z;
       ray.have_prev = false;
@@ -598,7 +618,8 @@ class RayCaster {
 
   Sampler sampler_;
   RaycastParams params_;
-  Eigen::Vector3f origin_W_;
+  Eigen::Vector3f origin_W_, origin_vox_;
+  float step_scale_;  // stored fixed-point TSDF to a step in metres along the ray
 };
 
 }  // namespace
@@ -628,6 +649,10 @@ void Raycast(const TsdfVolume& volume, const PinholeCamera& camera, const Pose3f
   const float z_start = MarchStart(volume, params);
   const Eigen::Matrix3f R_W_C = T_W_C.linear();
   const Eigen::Vector3f origin_W = T_W_C.translation();
+  // The ray through pixel (u, v), scaled to unit optical depth: d0 + u du + v dv.
+  const Eigen::Vector3f du_W = R_W_C.col(0) / camera.fx, dv_W = R_W_C.col(1) / camera.fy;
+  const Eigen::Vector3f d0_W = R_W_C.col(2) - camera.cx * du_W - camera.cy * dv_W;
+  const float surface_margin = 2.f * volume.voxel_size_m();
   const int tiles_x = (w + kTile - 1) / kTile, tiles_y = (h + kTile - 1) / kTile;
 
   auto write = [&](size_t px, const RayResult& ray, const Eigen::Vector3f& dir_W) {
@@ -649,39 +674,47 @@ void Raycast(const TsdfVolume& volume, const PinholeCamera& camera, const Pose3f
     RayCaster caster(volume, params, origin_W);
     for (size_t tile = begin; tile < end; ++tile) {
       const int u0 = int(tile % size_t(tiles_x)) * kTile, v0 = int(tile / size_t(tiles_x)) * kTile;
-      const int tile_w = std::min(kTile, w - u0), tile_h = std::min(kTile, h - v0);
-      const int tile_pixels = tile_w * tile_h;
-      int next = 0;
-      // Starts the tile's next ray that has a range to march; false when none is left.
-      auto start_next = [&](Ray* ray) {
-        while (next < tile_pixels) {
-          const int u = u0 + next % tile_w, v = v0 + next / tile_w;
-          ++next;
+      const int u_end = std::min(u0 + kTile, w), v_end = std::min(v0 + kTile, h);
+      // First the tile's pixels whose rays have a range to march, row by row; the others
+      // are written as unobserved at once.
+      RayTask tasks[kTile * kTile];
+      int num_tasks = 0;
+      for (int v = v0; v < v_end; ++v) {
+        const size_t range_row = size_t(v / kRangeCell) * size_t(range.cols);
+        const size_t surface_row = size_t(v / kSurfaceCell) * size_t(range.surface_cols);
+        for (int u = u0; u < u_end; ++u) {
           const size_t px = size_t(v) * size_t(w) + size_t(u);
           if (usable) {
-            const size_t cell =
-                size_t(v / kRangeCell) * size_t(range.cols) + size_t(u / kRangeCell);
+            const size_t cell = range_row + size_t(u / kRangeCell);
             const float z_all = std::max(range.z_min[cell], z_start);
             const float z_end = std::min(range.z_max[cell], params.max_depth_m);
-            // Start two voxels in front of the nearest block that can end a crossing, so the
-            // sample before the crossing is still taken.
-            const size_t surface_cell = size_t(v / kSurfaceCell) * size_t(range.surface_cols) +
-                                        size_t(u / kSurfaceCell);
-            const float z_surface = std::max(
-                range.surface_z_min[surface_cell] - 2.f * volume.voxel_size_m(), z_all);
             if (z_all <= z_end) {
-              const Eigen::Vector3f dir_C((float(u) - camera.cx) / camera.fx,
-                                          (float(v) - camera.cy) / camera.fy, 1.f);
+              // Start two voxels in front of the nearest block that can end a crossing, so
+              // the sample before the crossing is still taken.
+              const float z_surface = std::max(
+                  range.surface_z_min[surface_row + size_t(u / kSurfaceCell)] - surface_margin,
+                  z_all);
               const bool skip = z_surface <= z_end && z_surface > z_all;
-              caster.Start(R_W_C * dir_C, skip ? z_surface : z_all, z_end, ray);
-              ray->z_restart = skip ? z_all : -1.f;
-              ray->pixel = px;
-              return true;
+              tasks[num_tasks++] = {px, u, v, skip ? z_surface : z_all, z_end, skip ? z_all : -1.f};
+              continue;
             }
           }
-          write(px, RayResult{}, Eigen::Vector3f::Zero());
+          images.status.data[px] = uint8_t(RayStatus::kUnobserved);
+          images.depth.data[px] = 0.f;
+          images.vertex_W.data[px] = nan3;
+          images.normal_W.data[px] = nan3;
+          images.color.data[px] = 0;
         }
-        return false;
+      }
+      int next = 0;
+      auto start_next = [&](Ray* ray) {
+        if (next == num_tasks) return false;
+        const RayTask& task = tasks[next++];
+        caster.Start(d0_W + float(task.u) * du_W + float(task.v) * dv_W, task.z_begin, task.z_end,
+                     ray);
+        ray->z_restart = task.z_restart;
+        ray->pixel = task.pixel;
+        return true;
       };
       Ray rays[kLanes];
       bool live[kLanes];
