@@ -91,6 +91,9 @@ uint64_t EdgeKey(GlobalVoxelIndex g, int axis) {
          (uint64_t(uint32_t(g.z + kBias) & 0xfffff) << 40) | (uint64_t(axis) << 60);
 }
 
+}  // namespace
+
+namespace internal {
 struct BlockMesh {
   std::vector<uint64_t> keys;   // one per local vertex
   std::vector<uint8_t> shared;  // 1 when a neighbouring block's cubes use the same edge
@@ -98,6 +101,10 @@ struct BlockMesh {
   std::vector<std::array<uint8_t, 3>> colors;
   std::vector<std::array<uint32_t, 3>> triangles;  // local vertex ids
 };
+}  // namespace internal
+
+namespace {
+using internal::BlockMesh;
 
 // Welding within a block: grid edge (cell, axis) -> local vertex id, reset after each block
 // through the list of entries it set.
@@ -176,27 +183,29 @@ void MeshBlock(const TsdfVolume& volume, BlockIndex b, const MeshParams& params,
   edges.Reset();
 }
 
-}  // namespace
-
-Mesh ExtractMesh(const TsdfVolume& volume, const MeshParams& params) {
-  const std::vector<BlockIndex> blocks = volume.SortedBlockIndices();
-  std::vector<BlockMesh> parts(blocks.size());
+// Meshes `blocks` in parallel, one piece each (empty where no surface passes).
+void MeshBlocks(const TsdfVolume& volume, const std::vector<BlockIndex>& blocks,
+                const MeshParams& params, std::vector<BlockMesh>& parts) {
+  parts.assign(blocks.size(), BlockMesh{});
   ParallelFor(blocks.size(), 8, [&](size_t begin, size_t end) {
     auto grid = std::make_unique<LocalGrid>();
     EdgeVertexMap edges;
     for (size_t i = begin; i < end; ++i)
       MeshBlock(volume, blocks[i], params, *grid, edges, parts[i]);
   });
+}
 
+// Welds per-block pieces, given in block order, into one mesh with area-weighted normals.
+Mesh Assemble(const std::vector<const BlockMesh*>& parts, const MeshParams& params) {
   // Weld: blocks meet on shared edges, which carry the same key and identical values. Only
   // vertices on block borders can be shared; the first in block order stands for all.
   std::vector<size_t> offset(parts.size() + 1, 0);
-  for (size_t i = 0; i < parts.size(); ++i) offset[i + 1] = offset[i] + parts[i].keys.size();
+  for (size_t i = 0; i < parts.size(); ++i) offset[i + 1] = offset[i] + parts[i]->keys.size();
   const size_t total = offset.back();
   std::vector<std::pair<uint64_t, uint32_t>> border;
   for (size_t i = 0; i < parts.size(); ++i)
-    for (size_t k = 0; k < parts[i].keys.size(); ++k)
-      if (parts[i].shared[k]) border.emplace_back(parts[i].keys[k], uint32_t(offset[i] + k));
+    for (size_t k = 0; k < parts[i]->keys.size(); ++k)
+      if (parts[i]->shared[k]) border.emplace_back(parts[i]->keys[k], uint32_t(offset[i] + k));
   std::sort(border.begin(), border.end());
   std::vector<uint32_t> canonical(total);
   for (size_t k = 0; k < total; ++k) canonical[k] = uint32_t(k);
@@ -209,18 +218,18 @@ Mesh ExtractMesh(const TsdfVolume& volume, const MeshParams& params) {
   if (params.with_color) mesh.colors.reserve(total);
   std::vector<uint32_t> welded(total);
   for (size_t i = 0; i < parts.size(); ++i)
-    for (size_t k = 0; k < parts[i].keys.size(); ++k) {
+    for (size_t k = 0; k < parts[i]->keys.size(); ++k) {
       const size_t seq = offset[i] + k;
       if (canonical[seq] != seq) {
         welded[seq] = welded[canonical[seq]];
         continue;
       }
       welded[seq] = uint32_t(mesh.positions.size());
-      mesh.positions.push_back(parts[i].positions[k]);
-      if (params.with_color) mesh.colors.push_back(parts[i].colors[k]);
+      mesh.positions.push_back(parts[i]->positions[k]);
+      if (params.with_color) mesh.colors.push_back(parts[i]->colors[k]);
     }
   for (size_t i = 0; i < parts.size(); ++i)
-    for (const auto& tri : parts[i].triangles) {
+    for (const auto& tri : parts[i]->triangles) {
       const std::array<uint32_t, 3> t = {welded[offset[i] + tri[0]], welded[offset[i] + tri[1]],
                                          welded[offset[i] + tri[2]]};
       if (t[0] != t[1] && t[1] != t[2] && t[0] != t[2]) mesh.triangles.push_back(t);
@@ -238,6 +247,62 @@ Mesh ExtractMesh(const TsdfVolume& volume, const MeshParams& params) {
     n = len > 0.f ? Eigen::Vector3f(n / len) : Eigen::Vector3f::UnitZ();
   }
   return mesh;
+}
+
+}  // namespace
+
+Mesh ExtractMesh(const TsdfVolume& volume, const MeshParams& params) {
+  std::vector<BlockMesh> parts;
+  MeshBlocks(volume, volume.SortedBlockIndices(), params, parts);
+  std::vector<const BlockMesh*> pointers;
+  pointers.reserve(parts.size());
+  for (const BlockMesh& part : parts) pointers.push_back(&part);
+  return Assemble(pointers, params);
+}
+
+IncrementalMesher::IncrementalMesher(const MeshParams& params) : params_(params) {}
+IncrementalMesher::~IncrementalMesher() = default;
+IncrementalMesher::IncrementalMesher(IncrementalMesher&&) noexcept = default;
+IncrementalMesher& IncrementalMesher::operator=(IncrementalMesher&&) noexcept = default;
+
+size_t IncrementalMesher::Update(const TsdfVolume& volume, const std::vector<BlockIndex>& changed) {
+  std::vector<BlockIndex> dirty;
+  dirty.reserve(changed.size() * 8);
+  for (const BlockIndex& c : changed)
+    for (int n = 0; n < 8; ++n)
+      dirty.push_back({c.x - (n & 1), c.y - ((n >> 1) & 1), c.z - (n >> 2)});
+  std::sort(dirty.begin(), dirty.end());
+  dirty.erase(std::unique(dirty.begin(), dirty.end()), dirty.end());
+  // Only allocated blocks have cubes of their own; the others just lose their piece.
+  std::vector<BlockIndex> remesh;
+  remesh.reserve(dirty.size());
+  for (const BlockIndex& b : dirty) {
+    if (volume.FindBlock(b))
+      remesh.push_back(b);
+    else
+      pieces_.erase(b);
+  }
+  std::vector<BlockMesh> parts;
+  MeshBlocks(volume, remesh, params_, parts);
+  for (size_t i = 0; i < remesh.size(); ++i) {
+    if (parts[i].triangles.empty())
+      pieces_.erase(remesh[i]);
+    else
+      pieces_[remesh[i]] = std::make_unique<BlockMesh>(std::move(parts[i]));
+  }
+  return remesh.size();
+}
+
+void IncrementalMesher::Rebuild(const TsdfVolume& volume) {
+  pieces_.clear();
+  Update(volume, volume.SortedBlockIndices());
+}
+
+Mesh IncrementalMesher::Assemble() const {
+  std::vector<const BlockMesh*> pointers;
+  pointers.reserve(pieces_.size());
+  for (const auto& [b, piece] : pieces_) pointers.push_back(piece.get());
+  return voxplan::Assemble(pointers, params_);
 }
 
 }  // namespace voxplan

@@ -2,6 +2,10 @@
 // Marching cubes over the hashed volume: per block, with neighbour lookups across block borders,
 // vertices welded by the voxel edge they lie on, per-vertex colour and normals; parallel over
 // blocks and deterministic (same volume -> same mesh bytes, whatever the thread count).
+#include <map>
+#include <memory>
+#include <vector>
+
 #include "core/mesh.h"
 #include "core/volume.h"
 
@@ -13,5 +17,33 @@ struct MeshParams {
 };
 
 Mesh ExtractMesh(const TsdfVolume& volume, const MeshParams& params = {});
+
+namespace internal {
+struct BlockMesh;
+}
+
+// Meshing that keeps each block's piece and redoes only the pieces a frame can have changed:
+// a block's cubes read it and its +x/+y/+z neighbours, so a changed block dirties itself and
+// its seven -x/-y/-z neighbours. Assemble() welds the pieces exactly as ExtractMesh does, so
+// after any sequence of updates it returns the same bytes as ExtractMesh of the volume.
+class IncrementalMesher {
+ public:
+  explicit IncrementalMesher(const MeshParams& params = {});
+  ~IncrementalMesher();
+  IncrementalMesher(IncrementalMesher&&) noexcept;
+  IncrementalMesher& operator=(IncrementalMesher&&) noexcept;
+
+  // `changed`: every block whose voxels changed (or that was allocated or erased) since the
+  // last call, in any order. Returns how many blocks were meshed again.
+  size_t Update(const TsdfVolume& volume, const std::vector<BlockIndex>& changed);
+  // Meshes every block again (after loading a map, or changing parameters).
+  void Rebuild(const TsdfVolume& volume);
+  Mesh Assemble() const;
+  size_t num_pieces() const { return pieces_.size(); }  // blocks with at least one triangle
+
+ private:
+  MeshParams params_;
+  std::map<BlockIndex, std::unique_ptr<internal::BlockMesh>> pieces_;  // sorted, as ExtractMesh
+};
 
 }  // namespace voxplan

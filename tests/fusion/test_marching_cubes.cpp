@@ -4,6 +4,7 @@
 #include <cmath>
 #include <map>
 
+#include "fusion/integrate.h"
 #include "fusion/marching_cubes_table.h"
 #include "fusion/mesh_extract.h"
 #include "tests/support/test_support.h"
@@ -92,6 +93,68 @@ TEST(MarchingCubes, UnobservedVoxelsProduceNothing) {
   EXPECT_LT(half, full * 6 / 10);
   params.min_weight = 2.0f;  // every voxel has weight 1: all skipped
   EXPECT_EQ(ExtractMesh(volume, params).num_triangles(), 0u);
+}
+
+}  // namespace
+}  // namespace voxplan
+
+namespace voxplan {
+namespace {
+
+bool SameMesh(const Mesh& a, const Mesh& b) {
+  return a.positions == b.positions && a.normals == b.normals && a.colors == b.colors &&
+         a.triangles == b.triangles;
+}
+
+// Frames of a sphere seen from a camera that circles it: each frame changes some blocks, and
+// the incremental mesh must equal a from-scratch extraction after every one of them.
+TEST(IncrementalMesher, EqualsFullExtractionAfterEveryFrame) {
+  const test::Sphere sphere{{0.f, 0.f, 0.f}, 0.4f};
+  const PinholeCamera camera = test::TestCamera(120, 90);
+  TsdfVolume volume({0.02f, 0.06f});
+  IntegrateParams params;
+  IncrementalMesher mesher;
+  size_t remeshed_total = 0, blocks_total = 0;
+  for (int k = 0; k < 8; ++k) {
+    const float a = 0.6f * float(k);
+    const Eigen::Vector3f eye(1.3f * std::cos(a), 1.3f * std::sin(a), 0.3f);
+    const Pose3f T_W_C = test::LookAt(eye, sphere.c);
+    const DepthImage depth = test::RenderDepth(sphere, camera, T_W_C);
+    const std::vector<BlockIndex> touched =
+        BlocksInTruncationBand(depth, camera, T_W_C, params, volume.params());
+    ASSERT_TRUE(IntegrateFrame(depth, ColorImage{}, camera, T_W_C, params, volume).ok());
+    remeshed_total += mesher.Update(volume, touched);
+    blocks_total += volume.num_blocks();
+    const Mesh full = ExtractMesh(volume);
+    ASSERT_GT(full.num_triangles(), 0u);
+    ASSERT_TRUE(SameMesh(mesher.Assemble(), full)) << "after frame " << k;
+  }
+  // The point of it: fewer blocks meshed than a full extraction per frame would.
+  EXPECT_LT(remeshed_total, blocks_total);
+
+  IncrementalMesher rebuilt;
+  rebuilt.Rebuild(volume);
+  EXPECT_TRUE(SameMesh(rebuilt.Assemble(), ExtractMesh(volume)));
+  EXPECT_EQ(rebuilt.num_pieces(), mesher.num_pieces());
+}
+
+TEST(IncrementalMesher, ErasedBlocksLoseTheirPieces) {
+  const test::Sphere sphere{{0.f, 0.f, 0.f}, 0.3f};
+  TsdfVolume volume =
+      FillExact([&](const Eigen::Vector3f& p) { return sphere.Sdf(p); }, 0.02f, 0.06f,
+                Eigen::Vector3f::Constant(-0.5f), Eigen::Vector3f::Constant(0.5f));
+  IncrementalMesher mesher;
+  mesher.Rebuild(volume);
+  const size_t before = mesher.Assemble().num_triangles();
+  std::vector<BlockIndex> erased;
+  for (const BlockIndex& b : volume.SortedBlockIndices())
+    if (b.x >= 1) erased.push_back(b);
+  ASSERT_FALSE(erased.empty());
+  for (const BlockIndex& b : erased) volume.EraseBlock(b);
+  mesher.Update(volume, erased);
+  const Mesh after = mesher.Assemble();
+  EXPECT_LT(after.num_triangles(), before);
+  EXPECT_TRUE(SameMesh(after, ExtractMesh(volume)));
 }
 
 }  // namespace
