@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <cstring>
 #include <limits>
 #include <mutex>
 #include <string>
@@ -57,6 +58,9 @@ Status ValidateParams(const IntegrateParams& p) {
     return InvalidArgument("depth range must satisfy 0 <= min < max, got [" +
                            std::to_string(p.min_depth_m) + ", " + std::to_string(p.max_depth_m) +
                            "]");
+  if (p.carve_free_space && !(p.carve_ray_spacing_blocks > 0.f))
+    return InvalidArgument("carve ray spacing must be positive, got " +
+                           std::to_string(p.carve_ray_spacing_blocks));
   if (!(p.max_weight > 0.f && p.max_weight <= kMaxWeight))
     return InvalidArgument("max weight must be in (0, " + std::to_string(kMaxWeight) + "], got " +
                            std::to_string(p.max_weight));
@@ -91,9 +95,57 @@ const char* KernelName(Kernel kernel) {
   return "?";
 }
 
-std::vector<BlockIndex> BlocksInTruncationBand(const DepthImage& depth, const PinholeCamera& camera,
-                                               const Pose3f& T_W_C, const IntegrateParams& params,
-                                               const VolumeParams& volume_params) {
+namespace {
+
+// Carving ray tiles: square, small enough that rays through neighbouring tile corners are at
+// most carve_ray_spacing_blocks apart at max depth, and at most 64 pixels.
+int CarveTileSide(const PinholeCamera& camera, const IntegrateParams& params,
+                  const VolumeParams& volume_params) {
+  const float f_min = std::min(std::abs(camera.fx), std::abs(camera.fy));
+  const float block_m = volume_params.voxel_size_m * kBlockSide;
+  const float side = params.carve_ray_spacing_blocks * block_m * f_min / params.max_depth_m;
+  return std::clamp(int(side), 1, 64);
+}
+
+// Keys in, sorted blocks out.
+std::vector<BlockIndex> SortedBlocks(std::vector<uint64_t>& keys) {
+  std::sort(keys.begin(), keys.end());
+  keys.erase(std::unique(keys.begin(), keys.end()), keys.end());
+  std::vector<BlockIndex> blocks(keys.size());
+  std::transform(keys.begin(), keys.end(), blocks.begin(), UnpackBlockIndex);
+  std::sort(blocks.begin(), blocks.end());
+  return blocks;
+}
+
+// Per-task key collection: neighbouring rays hit the same blocks, so a small direct-mapped
+// cache drops most repeats before the global sort.
+class KeyCollector {
+ public:
+  KeyCollector() : cache_(size_t(1) << kCacheBits, ~0ull) {}
+  void Add(BlockIndex block) {
+    if (!InPackRange(block)) return;
+    const uint64_t key = PackBlockIndex(block);
+    // Fibonacci hashing: the top bits of key * 2^64/phi spread neighbouring blocks apart.
+    uint64_t& slot = cache_[(key * 0x9E3779B97F4A7C15ull) >> (64 - kCacheBits)];
+    if (slot == key) return;
+    slot = key;
+    keys_.push_back(key);
+  }
+  void MoveInto(std::vector<uint64_t>& keys, std::mutex& mutex) {
+    std::lock_guard<std::mutex> lock(mutex);
+    keys.insert(keys.end(), keys_.begin(), keys_.end());
+  }
+
+ private:
+  static constexpr int kCacheBits = 10;
+  std::vector<uint64_t> cache_;
+  std::vector<uint64_t> keys_;
+};
+
+// The band of every valid pixel, or with `carve` everything from min depth through the band.
+std::vector<BlockIndex> CollectBlocks(const DepthImage& depth, const PinholeCamera& camera,
+                                      const Pose3f& T_W_C, const IntegrateParams& params,
+                                      const VolumeParams& volume_params, bool carve) {
   const float trunc = volume_params.trunc_m;
   const float inv_block = 1.0f / (volume_params.voxel_size_m * kBlockSide);
   // Work in block units: a pixel's ray is dir(u, v) * z + origin, with dir linear in u and v.
@@ -105,23 +157,69 @@ std::vector<BlockIndex> BlocksInTruncationBand(const DepthImage& depth, const Pi
 
   std::vector<uint64_t> keys;
   std::mutex keys_mutex;
+  if (carve) {
+    // Carving: square pixel tiles small enough that rays through neighbouring tile corners
+    // are at most carve_ray_spacing_blocks apart at max depth, so the pencil of pixel rays
+    // between them is much thinner than a block. One ray per tile corner (shared by up to four
+    // tiles) from min depth to the farthest valid depth of those tiles plus the truncation
+    // covers the free space and the band of every pixel, instead of one band walk per pixel.
+    const int tile = CarveTileSide(camera, params, volume_params);
+    const int tiles_u = (depth.width + tile - 1) / tile, tiles_v = (depth.height + tile - 1) / tile;
+    // Farthest valid depth per tile: first per column over the tile's rows (element-wise, so
+    // it vectorises), then per tile over its columns.
+    std::vector<float> tile_max(size_t(tiles_u) * size_t(tiles_v), 0.f);
+    const float lo = params.min_depth_m, hi = params.max_depth_m;
+    ParallelFor(size_t(tiles_v), 1, [&](size_t begin, size_t end) {
+      std::vector<float> column_max(size_t(depth.width));
+      for (size_t tv = begin; tv < end; ++tv) {
+        std::fill(column_max.begin(), column_max.end(), 0.f);
+        const int v0 = int(tv) * tile, v1 = std::min(depth.height, v0 + tile);
+        for (int v = v0; v < v1; ++v) {
+          const float* __restrict depth_row = &depth.data[size_t(v) * size_t(depth.width)];
+          float* __restrict cm = column_max.data();
+          for (int u = 0; u < depth.width; ++u) {
+            const float d = depth_row[u];
+            const float x = ((d >= lo) & (d <= hi)) ? d : 0.f;
+            cm[u] = cm[u] > x ? cm[u] : x;
+          }
+        }
+        for (int tu = 0; tu < tiles_u; ++tu) {
+          const int u0 = tu * tile, u1 = std::min(depth.width, u0 + tile);
+          tile_max[tv * size_t(tiles_u) + size_t(tu)] =
+              *std::max_element(&column_max[size_t(u0)], &column_max[size_t(u1)]);
+        }
+      }
+    });
+    const float start = std::max(params.min_depth_m, 1e-3f);
+    ParallelFor(size_t(tiles_v) + 1, 1, [&](size_t begin, size_t end) {
+      KeyCollector collector;
+      auto add = [&](BlockIndex b) { collector.Add(b); };
+      for (size_t cv = begin; cv < end; ++cv) {
+        // Corner row cv lies between tile rows cv - 1 and cv, at pixel edge v = cv * tile - 0.5.
+        const float v = std::min(float(int(cv) * tile), float(depth.height)) - 0.5f;
+        for (int cu = 0; cu <= tiles_u; ++cu) {
+          float d_end = 0.f;
+          for (int tv = int(cv) - 1; tv <= int(cv); ++tv)
+            for (int tu = cu - 1; tu <= cu; ++tu)
+              if (tv >= 0 && tv < tiles_v && tu >= 0 && tu < tiles_u)
+                d_end = std::max(d_end, tile_max[size_t(tv) * size_t(tiles_u) + size_t(tu)]);
+          if (d_end == 0.f) continue;
+          const float u = std::min(float(cu * tile), float(depth.width)) - 0.5f;
+          const Eigen::Vector3f dir_b = d0_b + du_b * u + dv_b * v;
+          ForEachBlockOnSegment(dir_b * start + origin_b, dir_b * (d_end + trunc) + origin_b, 1.0f,
+                                add);
+        }
+      }
+      collector.MoveInto(keys, keys_mutex);
+    });
+    return SortedBlocks(keys);
+  }
+
   constexpr size_t kRowsPerTask = 8;
   const size_t tasks = (size_t(depth.height) + kRowsPerTask - 1) / kRowsPerTask;
   ParallelFor(tasks, 1, [&](size_t begin, size_t end) {
-    // Neighbouring pixels hit the same blocks: a small direct-mapped cache drops most repeats
-    // before the global sort.
-    constexpr int kCacheBits = 10;
-    std::vector<uint64_t> cache(size_t(1) << kCacheBits, ~0ull);
-    std::vector<uint64_t> local;
-    auto add = [&](BlockIndex block) {
-      if (!InPackRange(block)) return;
-      const uint64_t key = PackBlockIndex(block);
-      // Fibonacci hashing: the top bits of key * 2^64/phi spread neighbouring blocks apart.
-      uint64_t& slot = cache[(key * 0x9E3779B97F4A7C15ull) >> (64 - kCacheBits)];
-      if (slot == key) return;
-      slot = key;
-      local.push_back(key);
-    };
+    KeyCollector collector;
+    auto add = [&](BlockIndex b) { collector.Add(b); };
     for (size_t task = begin; task < end; ++task) {
       const int v_end = std::min<int>(depth.height, int((task + 1) * kRowsPerTask));
       for (int v = int(task * kRowsPerTask); v < v_end; ++v) {
@@ -152,15 +250,23 @@ std::vector<BlockIndex> BlocksInTruncationBand(const DepthImage& depth, const Pi
         }
       }
     }
-    std::lock_guard<std::mutex> lock(keys_mutex);
-    keys.insert(keys.end(), local.begin(), local.end());
+    collector.MoveInto(keys, keys_mutex);
   });
-  std::sort(keys.begin(), keys.end());
-  keys.erase(std::unique(keys.begin(), keys.end()), keys.end());
-  std::vector<BlockIndex> blocks(keys.size());
-  std::transform(keys.begin(), keys.end(), blocks.begin(), UnpackBlockIndex);
-  std::sort(blocks.begin(), blocks.end());
-  return blocks;
+  return SortedBlocks(keys);
+}
+
+}  // namespace
+
+std::vector<BlockIndex> BlocksInTruncationBand(const DepthImage& depth, const PinholeCamera& camera,
+                                               const Pose3f& T_W_C, const IntegrateParams& params,
+                                               const VolumeParams& volume_params) {
+  return CollectBlocks(depth, camera, T_W_C, params, volume_params, false);
+}
+
+std::vector<BlockIndex> BlocksToUpdate(const DepthImage& depth, const PinholeCamera& camera,
+                                       const Pose3f& T_W_C, const IntegrateParams& params,
+                                       const VolumeParams& volume_params) {
+  return CollectBlocks(depth, camera, T_W_C, params, volume_params, params.carve_free_space);
 }
 
 Result<IntegrateStats> IntegrateFrame(const DepthImage& depth, const ColorImage& color,
@@ -178,8 +284,7 @@ Result<IntegrateStats> IntegrateFrame(const DepthImage& depth, const ColorImage&
 
   IntegrateStats stats;
   auto t0 = std::chrono::steady_clock::now();
-  const std::vector<BlockIndex> band =
-      BlocksInTruncationBand(depth, camera, T_W_C, params, volume.params());
+  std::vector<BlockIndex> band = BlocksToUpdate(depth, camera, T_W_C, params, volume.params());
   std::vector<TsdfBlock*> blocks(band.size());
   for (size_t i = 0; i < band.size(); ++i) {
     bool created = false;
@@ -219,8 +324,12 @@ Result<IntegrateStats> IntegrateFrame(const DepthImage& depth, const ColorImage&
     for (size_t i = begin; i < end; ++i) kernel(f, band[i], *blocks[i]);
   });
   stats.update_ms = MsSince(t0);
+  // Branch-free, so it vectorises.
+  uint32_t valid = 0;
   for (float d : depth.data)
-    stats.valid_pixels += (d >= params.min_depth_m && d <= params.max_depth_m);
+    valid += uint32_t(d >= params.min_depth_m) & uint32_t(d <= params.max_depth_m);
+  stats.valid_pixels = valid;
+  stats.touched_blocks = std::move(band);
   return stats;
 }
 

@@ -25,14 +25,24 @@ struct IntegrateParams {
   Weighting weighting = Weighting::kConstant;
   Kernel kernel = Kernel::kAuto;
   bool integrate_color = true;
+  // Also allocate (and so update) the blocks in front of the truncation band, from min depth on,
+  // so free space is carved: voxels there get TSDF +1 and weight, which planning maps need.
+  bool carve_free_space = false;
+  // Carving replaces the per-pixel band walk with rays through the corners of square pixel
+  // tiles (out to the tiles' farthest depth plus the truncation), tiles small enough that
+  // neighbouring rays are at most this many blocks apart at max depth.
+  float carve_ray_spacing_blocks = 0.25f;
 };
 
 struct IntegrateStats {
-  size_t blocks_in_band = 0;  // blocks updated this frame
+  size_t blocks_in_band = 0;  // blocks updated this frame (band, plus carved ones when carving)
   size_t blocks_allocated = 0;
   size_t valid_pixels = 0;
   double allocate_ms = 0.0;
   double update_ms = 0.0;
+  // Every block this frame updated, sorted (BlockIndex order) without duplicates, so maps
+  // derived from the volume can update incrementally.
+  std::vector<BlockIndex> touched_blocks;
 };
 
 // depth: metres, 0 = invalid; color: empty or the same size as depth. Refuses (InvalidArgument)
@@ -45,6 +55,13 @@ Result<IntegrateStats> IntegrateFrame(const DepthImage& depth, const ColorImage&
 std::vector<BlockIndex> BlocksInTruncationBand(const DepthImage& depth, const PinholeCamera& camera,
                                                const Pose3f& T_W_C, const IntegrateParams& params,
                                                const VolumeParams& volume_params);
+
+// The blocks IntegrateFrame updates (sorted, without duplicates): BlocksInTruncationBand, or
+// with params.carve_free_space the blocks the carving rays cross from min depth through the
+// band.
+std::vector<BlockIndex> BlocksToUpdate(const DepthImage& depth, const PinholeCamera& camera,
+                                       const Pose3f& T_W_C, const IntegrateParams& params,
+                                       const VolumeParams& volume_params);
 
 // True when this CPU runs the SIMD kernel (AVX2); the one place the SIMD path is chosen.
 bool SimdKernelAvailable();

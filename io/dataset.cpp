@@ -406,6 +406,30 @@ Result<Draft> ReadTum(const fs::path& root) {
       "TUM folders carry no intrinsics: using Freiburg 1 (fx 517.3 fy 516.5 cx 318.6 cy 255.3); "
       "pass intrinsics for Freiburg 2/3 sequences";
 
+  // Optional camera.txt, one line "fx fy cx cy" (voxplan sim render writes it): overrides the
+  // Freiburg 1 default.
+  const std::string camera_txt = (root / "camera.txt").string();
+  std::error_code camera_ec;
+  if (fs::exists(camera_txt, camera_ec)) {
+    auto file = ReadTextFile(camera_txt);
+    if (!file.ok()) return file.status();
+    if (file->lines.size() != 1)
+      return CorruptData(camera_txt + ": expected one line 'fx fy cx cy', found " +
+                         std::to_string(file->lines.size()));
+    const TextLine& line = file->lines[0];
+    VOXPLAN_RETURN_IF_ERROR(ExpectTokens(*file, line, 4, "fx fy cx cy"));
+    double k[4];
+    VOXPLAN_RETURN_IF_ERROR(ParseNumbers(*file, line, 0, 4, k));
+    for (double v : k)
+      if (!std::isfinite(v)) return LineError(camera_txt, line.number, "intrinsics must be finite");
+    if (k[0] == 0.0 || k[1] == 0.0)
+      return LineError(camera_txt, line.number, "fx and fy must be non-zero");
+    const float kf[4] = {float(k[0]), float(k[1]), float(k[2]), float(k[3])};
+    SetIntrinsics(d, kf);
+    d.intrinsics_source = camera_txt;
+    d.default_intrinsics_warning.clear();
+  }
+
   const std::string depth_txt = (root / "depth.txt").string();
   const std::string rgb_txt = (root / "rgb.txt").string();
   const std::string gt_txt = (root / "groundtruth.txt").string();

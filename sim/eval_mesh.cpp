@@ -32,37 +32,43 @@ constexpr size_t kQueryGrain = 1024;
 // Non-degenerate triangles in double precision with their areas.
 struct TriangleSet {
   std::vector<Triangle> triangles;
+  std::vector<uint32_t> source;            // index of each triangle in the mesh
   std::vector<double> cumulative_area_m2;  // inclusive prefix sums, for area-weighted sampling
   double area_m2 = 0.0;
 };
 
-Result<TriangleSet> CollectTriangles(const Mesh& mesh, const char* name) {
-  if (mesh.empty()) return InvalidArgument(std::string("EvaluateMesh: ") + name + " is empty");
+// The triangles of `mesh` listed in `subset` (all of them when empty). `what` starts messages.
+Result<TriangleSet> CollectTriangles(const Mesh& mesh, const std::string& what,
+                                     const std::vector<uint32_t>& subset = {}) {
+  if (mesh.empty()) return InvalidArgument(what + " is empty");
+  const size_t count = subset.empty() ? mesh.num_triangles() : subset.size();
   TriangleSet set;
-  set.triangles.reserve(mesh.num_triangles());
-  set.cumulative_area_m2.reserve(mesh.num_triangles());
+  set.triangles.reserve(count);
+  set.source.reserve(count);
+  set.cumulative_area_m2.reserve(count);
   const size_t nv = mesh.num_vertices();
-  for (size_t t = 0; t < mesh.num_triangles(); ++t) {
+  for (size_t k = 0; k < count; ++k) {
+    const size_t t = subset.empty() ? k : size_t(subset[k]);
+    if (t >= mesh.num_triangles())
+      return InvalidArgument(what + ": triangle " + std::to_string(t) + " is out of range");
     const auto& tri = mesh.triangles[t];
     if (tri[0] >= nv || tri[1] >= nv || tri[2] >= nv)
-      return InvalidArgument(std::string("EvaluateMesh: ") + name + " triangle " +
-                             std::to_string(t) + " indexes a missing vertex");
+      return InvalidArgument(what + " triangle " + std::to_string(t) + " indexes a missing vertex");
     const Eigen::Vector3d a = mesh.positions[tri[0]].cast<double>();
     const Eigen::Vector3d b = mesh.positions[tri[1]].cast<double>();
     const Eigen::Vector3d c = mesh.positions[tri[2]].cast<double>();
     if (!a.allFinite() || !b.allFinite() || !c.allFinite())
-      return InvalidArgument(std::string("EvaluateMesh: ") + name + " triangle " +
-                             std::to_string(t) + " has a non-finite vertex");
+      return InvalidArgument(what + " triangle " + std::to_string(t) + " has a non-finite vertex");
     const double area = 0.5 * (b - a).cross(c - a).norm();
     // Degenerate triangles carry no surface and upset CGAL's point-triangle distance.
     if (!(area > 0.0)) continue;
     set.triangles.emplace_back(Point(a.x(), a.y(), a.z()), Point(b.x(), b.y(), b.z()),
                                Point(c.x(), c.y(), c.z()));
+    set.source.push_back(uint32_t(t));
     set.area_m2 += area;
     set.cumulative_area_m2.push_back(set.area_m2);
   }
-  if (set.triangles.empty())
-    return InvalidArgument(std::string("EvaluateMesh: ") + name + " has no triangle with area");
+  if (set.triangles.empty()) return InvalidArgument(what + " has no triangle with area");
   return set;
 }
 
@@ -71,9 +77,11 @@ Result<TriangleSet> CollectTriangles(const Mesh& mesh, const char* name) {
 double Uniform01(std::mt19937_64& rng) { return double(rng() >> 11) * 0x1.0p-53; }
 
 // Area-weighted uniform samples on the surface: a fixed count, triangles drawn by area.
-std::vector<Point> SampleSurface(const TriangleSet& set, double samples_per_m2, uint64_t seed) {
-  const size_t count =
-      size_t(std::min(double(kMaxSamples), std::max(1.0, std::ceil(set.area_m2 * samples_per_m2))));
+std::vector<Point> SamplePoints(const TriangleSet& set, double samples_per_m2, uint64_t seed,
+                                size_t min_samples = 1) {
+  const double wanted =
+      std::max(double(std::max<size_t>(min_samples, 1)), std::ceil(set.area_m2 * samples_per_m2));
+  const size_t count = size_t(std::min(double(kMaxSamples), wanted));
   std::mt19937_64 rng(seed);
   std::vector<Point> samples;
   samples.reserve(count);
@@ -94,21 +102,40 @@ std::vector<Point> SampleSurface(const TriangleSet& set, double samples_per_m2, 
   return samples;
 }
 
-// Distance from every sample to the surface of `target`.
-std::vector<double> DistancesTo(const TriangleSet& target, const std::vector<Point>& samples) {
-  Tree tree(target.triangles.begin(), target.triangles.end());
-  // Build both the tree and its distance search structure now: afterwards queries are const
-  // and safe from many threads.
-  tree.build();
-  tree.accelerate_distance_queries();
-  (void)tree.squared_distance(samples.empty() ? Point(0, 0, 0) : samples.front());
-  std::vector<double> distances(samples.size());
-  ParallelFor(samples.size(), kQueryGrain, [&](size_t begin, size_t end) {
-    for (size_t i = begin; i < end; ++i)
-      distances[i] = std::sqrt(CGAL::to_double(tree.squared_distance(samples[i])));
-  });
-  return distances;
-}
+// A triangle set and its AABB tree; never moves once built, since the tree points into the set.
+struct SurfaceTree {
+  TriangleSet set;
+  Tree tree;
+
+  explicit SurfaceTree(TriangleSet s)
+      : set(std::move(s)), tree(set.triangles.begin(), set.triangles.end()) {
+    // Build both the tree and its distance search structure now: afterwards queries are const
+    // and safe from many threads.
+    tree.build();
+    tree.accelerate_distance_queries();
+    (void)tree.squared_distance(set.triangles.front()[0]);
+  }
+
+  // Distance from every sample to the surface, and optionally the mesh index of the closest
+  // triangle.
+  std::vector<double> Distances(const std::vector<Point>& samples,
+                                std::vector<uint32_t>* closest_triangle) const {
+    std::vector<double> distances(samples.size());
+    if (closest_triangle) closest_triangle->assign(samples.size(), 0);
+    ParallelFor(samples.size(), kQueryGrain, [&](size_t begin, size_t end) {
+      for (size_t i = begin; i < end; ++i) {
+        if (!closest_triangle) {
+          distances[i] = std::sqrt(CGAL::to_double(tree.squared_distance(samples[i])));
+          continue;
+        }
+        const auto [point, id] = tree.closest_point_and_primitive(samples[i]);
+        distances[i] = std::sqrt(CGAL::to_double(CGAL::squared_distance(samples[i], point)));
+        (*closest_triangle)[i] = set.source[size_t(id - set.triangles.begin())];
+      }
+    });
+    return distances;
+  }
+};
 
 double Median(std::vector<double> values) {
   if (values.empty()) return 0.0;
@@ -127,18 +154,18 @@ Result<MeshEvalResult> EvaluateMesh(const Mesh& reconstruction, const Mesh& grou
     return InvalidArgument("EvaluateMesh: samples_per_m2 must be positive");
   if (!(params.threshold_m >= 0.f) || !std::isfinite(params.threshold_m))
     return InvalidArgument("EvaluateMesh: threshold_m must be non-negative");
-  Result<TriangleSet> recon = CollectTriangles(reconstruction, "reconstruction");
+  Result<TriangleSet> recon = CollectTriangles(reconstruction, "EvaluateMesh: reconstruction");
   if (!recon.ok()) return recon.status();
-  Result<TriangleSet> truth = CollectTriangles(ground_truth, "ground truth");
+  Result<TriangleSet> truth = CollectTriangles(ground_truth, "EvaluateMesh: ground truth");
   if (!truth.ok()) return truth.status();
 
   // Independent streams for the two surfaces, both fixed by the one seed.
   std::seed_seq recon_seq{params.seed, uint64_t(0)}, truth_seq{params.seed, uint64_t(1)};
   std::mt19937_64 seeder_recon(recon_seq), seeder_truth(truth_seq);
   const std::vector<Point> recon_samples =
-      SampleSurface(*recon, params.samples_per_m2, seeder_recon());
+      SamplePoints(*recon, params.samples_per_m2, seeder_recon());
   const std::vector<Point> truth_samples =
-      SampleSurface(*truth, params.samples_per_m2, seeder_truth());
+      SamplePoints(*truth, params.samples_per_m2, seeder_truth());
 
   MeshEvalResult result;
   result.reconstruction_area_m2 = recon->area_m2;
@@ -148,7 +175,9 @@ Result<MeshEvalResult> EvaluateMesh(const Mesh& reconstruction, const Mesh& grou
 
   // Accuracy (eq. 9): reconstruction samples to the ground-truth surface. Samples are equal-area,
   // so the area weights of the paper become a plain mean.
-  const std::vector<double> accuracy = DistancesTo(*truth, recon_samples);
+  // One tree at a time (each built from a set it then owns), to bound peak memory on large meshes.
+  const std::vector<double> accuracy =
+      SurfaceTree(std::move(*truth)).Distances(recon_samples, nullptr);
   double sum = 0.0, sum_sq = 0.0;
   for (double d : accuracy) {
     sum += d;
@@ -175,7 +204,8 @@ Result<MeshEvalResult> EvaluateMesh(const Mesh& reconstruction, const Mesh& grou
   const size_t kept_count = size_t(std::count(kept.begin(), kept.end(), uint8_t(1)));
   if (kept_count == 0)
     return InvalidArgument("EvaluateMesh: ground_truth_filter keeps no ground-truth sample");
-  const std::vector<double> coverage = DistancesTo(*recon, truth_samples);
+  const std::vector<double> coverage =
+      SurfaceTree(std::move(*recon)).Distances(truth_samples, nullptr);
   const double threshold = double(params.threshold_m);
   size_t covered = 0, covered_kept = 0;
   for (size_t i = 0; i < coverage.size(); ++i) {
@@ -187,6 +217,45 @@ Result<MeshEvalResult> EvaluateMesh(const Mesh& reconstruction, const Mesh& grou
   result.completeness = double(covered_kept) / double(kept_count);
   result.completeness_all = double(covered) / double(coverage.size());
   return result;
+}
+
+Result<SurfaceSamples> SampleSurface(const Mesh& mesh, double samples_per_m2, uint64_t seed,
+                                     const std::vector<uint32_t>& triangles, size_t min_samples,
+                                     const std::string& what) {
+  if (!(samples_per_m2 > 0.0) || !std::isfinite(samples_per_m2))
+    return InvalidArgument("SampleSurface: samples_per_m2 must be positive");
+  Result<TriangleSet> set = CollectTriangles(mesh, what, triangles);
+  if (!set.ok()) return set.status();
+  SurfaceSamples samples;
+  samples.area_m2 = set->area_m2;
+  const std::vector<Point> points = SamplePoints(*set, samples_per_m2, seed, min_samples);
+  samples.points.reserve(points.size());
+  for (const Point& p : points) samples.points.emplace_back(p.x(), p.y(), p.z());
+  return samples;
+}
+
+struct SurfaceDistance::Impl {
+  explicit Impl(TriangleSet set) : surface(std::move(set)) {}
+  SurfaceTree surface;
+};
+
+SurfaceDistance::SurfaceDistance(std::unique_ptr<Impl> impl) : impl_(std::move(impl)) {}
+SurfaceDistance::SurfaceDistance(SurfaceDistance&&) noexcept = default;
+SurfaceDistance& SurfaceDistance::operator=(SurfaceDistance&&) noexcept = default;
+SurfaceDistance::~SurfaceDistance() = default;
+
+Result<SurfaceDistance> SurfaceDistance::Build(const Mesh& mesh, const std::string& what) {
+  Result<TriangleSet> set = CollectTriangles(mesh, what);
+  if (!set.ok()) return set.status();
+  return SurfaceDistance(std::make_unique<Impl>(std::move(*set)));
+}
+
+std::vector<double> SurfaceDistance::Distances(const std::vector<Eigen::Vector3d>& points,
+                                               std::vector<uint32_t>* closest_triangle) const {
+  std::vector<Point> samples;
+  samples.reserve(points.size());
+  for (const Eigen::Vector3d& p : points) samples.emplace_back(p.x(), p.y(), p.z());
+  return impl_->surface.Distances(samples, closest_triangle);
 }
 
 }  // namespace voxplan

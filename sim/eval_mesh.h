@@ -7,6 +7,9 @@
 #include <Eigen/Core>
 #include <cstdint>
 #include <functional>
+#include <memory>
+#include <string>
+#include <vector>
 
 #include "core/mesh.h"
 #include "core/status.h"
@@ -38,5 +41,40 @@ struct MeshEvalResult {
 // Refuses empty meshes, and a filter that keeps no ground-truth sample.
 Result<MeshEvalResult> EvaluateMesh(const Mesh& reconstruction, const Mesh& ground_truth,
                                     const MeshEvalParams& params = {});
+
+// The building blocks EvaluateMesh uses, shared with per-object evaluation (sim/eval_objects.h).
+
+// Area-weighted uniform surface samples of `mesh`, restricted to the triangles listed in
+// `triangles` when it is not empty. count = ceil(area * samples_per_m2), at least min_samples,
+// at most 2,000,000. Degenerate triangles are skipped. Refuses an empty mesh or selection,
+// indices out of range, non-finite vertices and a selection without area; `what` names the mesh
+// in messages. The same arguments give the same samples on every platform.
+struct SurfaceSamples {
+  std::vector<Eigen::Vector3d> points;
+  double area_m2 = 0.0;  // of the sampled triangles
+};
+Result<SurfaceSamples> SampleSurface(const Mesh& mesh, double samples_per_m2, uint64_t seed,
+                                     const std::vector<uint32_t>& triangles = {},
+                                     size_t min_samples = 1, const std::string& what = "mesh");
+
+// Distances from points to a triangle surface, through an AABB tree built once.
+class SurfaceDistance {
+ public:
+  // Refuses what SampleSurface refuses (the whole mesh is used).
+  static Result<SurfaceDistance> Build(const Mesh& mesh, const std::string& what = "mesh");
+  SurfaceDistance(SurfaceDistance&&) noexcept;
+  SurfaceDistance& operator=(SurfaceDistance&&) noexcept;
+  ~SurfaceDistance();
+
+  // Distance from each point to the surface, in parallel; with `closest_triangle`, also the
+  // index (into the mesh's triangles) of the triangle holding the closest surface point.
+  std::vector<double> Distances(const std::vector<Eigen::Vector3d>& points,
+                                std::vector<uint32_t>* closest_triangle = nullptr) const;
+
+ private:
+  struct Impl;
+  explicit SurfaceDistance(std::unique_ptr<Impl> impl);
+  std::unique_ptr<Impl> impl_;
+};
 
 }  // namespace voxplan

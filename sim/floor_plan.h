@@ -21,6 +21,15 @@ struct FloorPlanParams {
   float resolution_m = 0.05f;
   float min_z_m = 0.1f;  // height band that blocks a robot, above the floor at z = 0
   float max_z_m = 1.8f;
+  // A floor triangle is a roughly horizontal one (|n_z| >= 0.7 |n|, either orientation) at a
+  // height in [floor_min_z_m, min_z_m) over the cell centre.
+  float floor_min_z_m = -0.5f;
+  // Cells inside a closed solid that spans the whole band (a wall's core, a tall wardrobe) have
+  // no triangle in the band; with fill_solids they are obstacles too: the upward ray from
+  // (cell centre, min_z_m) first meets the back of a face (normal pointing up). Relies on
+  // outward-facing normals: a single-sided surface facing up above the band (a roof without a
+  // ceiling) would read as solid; turn it off for such scenes.
+  bool fill_solids = true;
 };
 
 struct FloorPlan {

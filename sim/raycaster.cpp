@@ -51,6 +51,7 @@ struct MeshRaycaster::Impl {
   std::vector<float> vertices_xyz;  // 3 floats per vertex plus one pad float (Embree reads 16 B)
   std::vector<uint32_t> indices;    // 3 per triangle
   std::vector<std::array<uint8_t, 3>> colors;  // empty or one per vertex
+  std::vector<uint32_t> triangle_instance;     // empty or one per triangle
 
   ~Impl() {
     if (scene) rtcReleaseScene(scene);
@@ -135,6 +136,17 @@ Result<std::unique_ptr<MeshRaycaster>> MeshRaycaster::Create(const Mesh& mesh) {
   return raycaster;
 }
 
+Result<std::unique_ptr<MeshRaycaster>> MeshRaycaster::Create(const World& world) {
+  if (world.triangle_instance.size() != world.mesh.num_triangles())
+    return InvalidArgument("MeshRaycaster: world '" + world.name + "' has " +
+                           std::to_string(world.triangle_instance.size()) + " instance ids for " +
+                           std::to_string(world.mesh.num_triangles()) + " triangles");
+  auto raycaster = Create(world.mesh);
+  if (!raycaster.ok()) return raycaster.status();
+  (*raycaster)->impl_->triangle_instance = world.triangle_instance;
+  return raycaster;
+}
+
 MeshRaycaster::~MeshRaycaster() = default;
 
 RenderOutput MeshRaycaster::Render(const PinholeCamera& camera, const Pose3f& T_W_C,
@@ -143,7 +155,10 @@ RenderOutput MeshRaycaster::Render(const PinholeCamera& camera, const Pose3f& T_
   if (!camera.Valid()) return out;
   const int width = camera.width, height = camera.height;
   out.depth = DepthImage(width, height, 0.f);
-  out.color = ColorImage(width, height, PackRgb(0, 0, 0));
+  if (params.color) out.color = ColorImage(width, height, PackRgb(0, 0, 0));
+  if (params.labels) out.labels = LabelImage(width, height, kNoInstance);
+  if (params.normals)
+    out.normals_C = Image<Eigen::Vector3f>(width, height, Eigen::Vector3f::Zero());
 
   // Ray directions keep z_C = 1, so the hit distance t is the depth along the optical axis
   // whatever the signs of fx, fy. dir_W = R_W_C * (x_C, y_C, 1) splits into a per-column and a
@@ -199,8 +214,23 @@ RenderOutput MeshRaycaster::Render(const PinholeCamera& camera, const Pose3f& T_
           for (int i = 0; i < kPacketSize; ++i) {
             if (!valid[i] || rayhit.hit.geomID[i] == RTC_INVALID_GEOMETRY_ID) continue;
             const int u = pu + i % kPacketW, v = pv + i / kPacketW;
+            const uint32_t prim = rayhit.hit.primID[i];
             out.depth.at(u, v) = rayhit.ray.tfar[i];
-            out.color.at(u, v) = impl.Shade(rayhit.hit.primID[i], rayhit.hit.u[i], rayhit.hit.v[i]);
+            if (params.color)
+              out.color.at(u, v) = impl.Shade(prim, rayhit.hit.u[i], rayhit.hit.v[i]);
+            if (params.labels && !impl.triangle_instance.empty())
+              out.labels.at(u, v) = impl.triangle_instance[prim];
+            if (params.normals) {
+              // Ng is unnormalised and world-frame; R^T takes it to the camera frame, where the
+              // ray is (x_C, y_C, 1).
+              const Eigen::Vector3f ng_W(rayhit.hit.Ng_x[i], rayhit.hit.Ng_y[i],
+                                         rayhit.hit.Ng_z[i]);
+              Eigen::Vector3f n_C = (R_W_C.transpose() * ng_W).normalized();
+              const Eigen::Vector3f ray_C((float(u) - camera.cx) / camera.fx,
+                                          (float(v) - camera.cy) / camera.fy, 1.f);
+              if (n_C.dot(ray_C) > 0.f) n_C = -n_C;
+              out.normals_C.at(u, v) = n_C;
+            }
           }
         }
     }

@@ -1,5 +1,7 @@
 #pragma once
-// Embree 3 ray casting of a triangle mesh into depth and colour images, parallel over tiles.
+// Embree 3 ray casting of a triangle mesh into depth, colour, instance-label and normal images,
+// parallel over tiles of 16-ray packets.
+#include <Eigen/Core>
 #include <memory>
 
 #include "core/camera.h"
@@ -7,22 +9,37 @@
 #include "core/mesh.h"
 #include "core/pose.h"
 #include "core/status.h"
+#include "sim/world.h"
 
 namespace voxplan {
 
 struct RenderParams {
   float max_range_m = 0.0f;  // 0: unlimited; farther hits give depth 0
+  bool color = true;         // fill RenderOutput::color
+  bool labels = false;       // fill RenderOutput::labels
+  bool normals = false;      // fill RenderOutput::normals_C
 };
 
 struct RenderOutput {
   DepthImage depth;  // z along the optical axis, metres; 0 where no hit
-  ColorImage color;  // interpolated vertex colour (grey when the mesh has none); black on miss
+  // Interpolated vertex colour (grey when the mesh has none); black on a miss. Empty unless
+  // RenderParams::color.
+  ColorImage color;
+  // Instance id of the hit triangle (World::triangle_instance); kNoInstance on a miss, and
+  // everywhere for a raycaster made from a bare Mesh. Empty unless RenderParams::labels.
+  LabelImage labels;
+  // Unit geometric normal of the hit triangle in the camera frame, turned towards the camera
+  // (n . ray < 0); zero on a miss. Empty unless RenderParams::normals.
+  Image<Eigen::Vector3f> normals_C;
 };
 
 class MeshRaycaster {
  public:
   // Builds the Embree scene; Embree errors become a Status.
   static Result<std::unique_ptr<MeshRaycaster>> Create(const Mesh& mesh);
+  // As above, and labels pixels with the world's per-triangle instance ids; refuses a world
+  // whose triangle_instance does not have one entry per triangle.
+  static Result<std::unique_ptr<MeshRaycaster>> Create(const World& world);
   ~MeshRaycaster();
   MeshRaycaster(const MeshRaycaster&) = delete;
   MeshRaycaster& operator=(const MeshRaycaster&) = delete;

@@ -37,6 +37,7 @@ Command AddSimCommand(CLI::App& app);
 // Subcommands that live in their own files, added to a parent command above.
 Command AddSimSceneCommand(CLI::App& sim);     // sim scene   (cmd_sim_scene.cpp)
 Command AddSimRenderCommand(CLI::App& sim);    // sim render  (cmd_sim_render.cpp)
+Command AddSimTourCommand(CLI::App& sim);      // sim tour    (cmd_sim_tour.cpp)
 Command AddBenchMapsCommand(CLI::App& bench);  // bench maps  (cmd_bench_maps.cpp)
 std::vector<Command> AddEvalSimCommands(
     CLI::App& eval);  // eval of simulated runs (cmd_eval_sim.cpp)

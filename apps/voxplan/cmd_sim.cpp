@@ -6,7 +6,8 @@ namespace voxplan::cli {
 Command AddSimCommand(CLI::App& app) {
   CLI::App* sim = app.add_subcommand("sim", "Simulated worlds and RGB-D sensors");
   sim->require_subcommand(1);
-  std::vector<Command> subs = {AddSimSceneCommand(*sim), AddSimRenderCommand(*sim)};
+  std::vector<Command> subs = {AddSimSceneCommand(*sim), AddSimRenderCommand(*sim),
+                               AddSimTourCommand(*sim)};
   return {sim, [subs] { return RunParsed(subs); }};
 }
 

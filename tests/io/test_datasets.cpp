@@ -354,6 +354,37 @@ TEST(Datasets, TumAssociationAndInterpolation) {
   EXPECT_FALSE(AnyWarning(fr3->info(), "Freiburg 1"));
 }
 
+// camera.txt beside the lists ("fx fy cx cy", as `voxplan sim render` writes it) replaces the
+// Freiburg 1 default; a malformed one is refused naming the file.
+TEST(Datasets, TumCameraTxtGivesIntrinsics) {
+  test::TempDir dir("tum");
+  MakeTumFolder(dir.path());
+  WriteText(dir / "camera.txt", "# fx fy cx cy\n554.25 -554.25 319.5 239.5\n");
+  auto ds = OpenOk(dir.path());
+  ASSERT_TRUE(ds);
+  const DatasetInfo& info = ds->info();
+  EXPECT_EQ(info.camera.fx, 554.25f);
+  EXPECT_EQ(info.camera.fy, -554.25f);
+  EXPECT_EQ(info.camera.cx, 319.5f);
+  EXPECT_EQ(info.camera.cy, 239.5f);
+  EXPECT_TRUE(Contains(info.intrinsics_source, "camera.txt"));
+  EXPECT_FALSE(AnyWarning(info, "Freiburg 1"));
+  // The flag still wins over the file.
+  DatasetOptions options;
+  options.intrinsics = PinholeCamera{0, 0, 535.4f, 539.2f, 320.1f, 247.6f};
+  auto flagged = OpenOk(dir.path(), options);
+  ASSERT_TRUE(flagged);
+  EXPECT_EQ(flagged->info().camera.fx, 535.4f);
+
+  for (const char* bad : {"554.25 554.25 319.5\n", "554.25 0 319.5 239.5\n",
+                          "554.25 554.25 nan 239.5\n", "1 1 1 1\n2 2 2 2\n"}) {
+    WriteText(dir / "camera.txt", bad);
+    auto refused = OpenDataset(dir.path().string());
+    ASSERT_FALSE(refused.ok()) << bad;
+    EXPECT_TRUE(Contains(refused.status().message(), "camera.txt")) << refused.status().message();
+  }
+}
+
 TEST(Datasets, TumNearUnitQuaternionIsRenormalisedWithWarning) {
   test::TempDir dir("tum");
   std::string gt = kTumGt;

@@ -202,5 +202,78 @@ TEST(MeshRaycaster, EmptyMeshRendersNothing) {
   for (float z : out.depth.data) EXPECT_EQ(z, 0.f);
 }
 
+// Two boxes as a World: instance 3 (left) and 7 (right, farther), both of kept triangle order.
+World TwoBoxWorld() {
+  World world;
+  world.name = "two boxes";
+  const Mesh a = BoxMesh({-1.2f, -0.5f, 0.f}, {-0.2f, 0.5f, 1.f});
+  const Mesh b = BoxMesh({0.4f, 0.5f, 0.f}, {1.4f, 1.5f, 1.5f});
+  world.mesh = a;
+  for (const auto& t : b.triangles) world.mesh.triangles.push_back({t[0] + 8, t[1] + 8, t[2] + 8});
+  world.mesh.positions.insert(world.mesh.positions.end(), b.positions.begin(), b.positions.end());
+  world.triangle_instance.assign(12, 3);
+  world.triangle_instance.resize(24, 7);
+  world.instances = {{3, "box", "a", {}}, {7, "box", "b", {}}};
+  return world;
+}
+
+TEST(MeshRaycaster, LabelsAreInstanceIdsOfTheNearestBox) {
+  const World world = TwoBoxWorld();
+  auto raycaster = MeshRaycaster::Create(world);
+  ASSERT_TRUE(raycaster.ok()) << raycaster.status().message();
+  const test::Box box_a{{-1.2f, -0.5f, 0.f}, {-0.2f, 0.5f, 1.f}};
+  const test::Box box_b{{0.4f, 0.5f, 0.f}, {1.4f, 1.5f, 1.5f}};
+  const PinholeCamera camera = TestCamera(160, 120);
+  RenderParams params;
+  params.labels = true;
+  params.normals = true;
+  for (const Eigen::Vector3f& eye :
+       {Eigen::Vector3f(0.f, -4.f, 1.5f), Eigen::Vector3f(3.f, -3.f, 2.f)}) {
+    const Pose3f T_W_C = LookAt(eye, Eigen::Vector3f(0.1f, 0.5f, 0.5f));
+    const RenderOutput out = (*raycaster)->Render(camera, T_W_C, params);
+    ASSERT_EQ(out.labels.width, camera.width);
+    const DepthImage da = test::RenderDepth(box_a, camera, T_W_C);
+    const DepthImage db = test::RenderDepth(box_b, camera, T_W_C);
+    int seen_a = 0, seen_b = 0;
+    for (int v = 0; v < camera.height; ++v)
+      for (int u = 0; u < camera.width; ++u) {
+        if (IsSilhouette(da, u, v) || IsSilhouette(db, u, v)) continue;
+        const float za = da.at(u, v), zb = db.at(u, v);
+        uint32_t expected = kNoInstance;
+        if (za > 0.f && (zb == 0.f || za < zb)) expected = 3;
+        if (zb > 0.f && (za == 0.f || zb < za)) expected = 7;
+        EXPECT_EQ(out.labels.at(u, v), expected) << u << "," << v;
+        seen_a += expected == 3;
+        seen_b += expected == 7;
+        // Normals: unit, facing the camera, along a world axis (box faces).
+        const Eigen::Vector3f n_C = out.normals_C.at(u, v);
+        if (expected == kNoInstance) {
+          EXPECT_EQ(n_C, Eigen::Vector3f::Zero());
+          continue;
+        }
+        EXPECT_NEAR(n_C.norm(), 1.f, 1e-5f);
+        EXPECT_LT(n_C.dot(camera.Unproject(float(u), float(v), 1.f)), 0.f);
+        const Eigen::Vector3f n_W = T_W_C.linear() * n_C;
+        EXPECT_NEAR(n_W.cwiseAbs().maxCoeff(), 1.f, 1e-5f);
+      }
+    EXPECT_GT(seen_a, 200);
+    EXPECT_GT(seen_b, 200);
+  }
+  // Without `labels`, no label image; a Mesh-made raycaster labels nothing.
+  EXPECT_TRUE((*raycaster)->Render(camera, LookAt({0, -4, 1}, {0, 0, 0.5f})).labels.empty());
+  auto bare = MeshRaycaster::Create(world.mesh);
+  ASSERT_TRUE(bare.ok());
+  const RenderOutput unlabeled = (*bare)->Render(camera, LookAt({0, -4, 1}, {0, 0, 0.5f}), params);
+  for (uint32_t id : unlabeled.labels.data) EXPECT_EQ(id, kNoInstance);
+}
+
+TEST(MeshRaycaster, RefusesWorldWithoutOneIdPerTriangle) {
+  World world = TwoBoxWorld();
+  world.triangle_instance.pop_back();
+  auto r = MeshRaycaster::Create(world);
+  ASSERT_FALSE(r.ok());
+  EXPECT_NE(r.status().message().find("two boxes"), std::string::npos) << r.status().message();
+}
+
 }  // namespace
 }  // namespace voxplan

@@ -1,0 +1,142 @@
+#pragma once
+// Loads planner plugins (plugins/planner_api.h) and runs their plan calls.
+//
+//   auto planner = LoadPlanner("omt", {.config_json = "{}", .seed = 1});  // or a path to a .so
+//   if (!planner.ok()) return planner.status();   // names both ABI versions on a mismatch
+//   Result<PlanResult> plan = (*planner)->Plan(world, {.event = PlanEvent::kStart});
+//
+// A name is looked up as libvoxplan_planner_<name>.so in the search path: $VOXPLAN_PLANNER_PATH
+// (colon-separated) first, then the folder the build puts planners in. The host refuses, with a
+// Status and never a crash, a file it cannot dlopen, a missing entry symbol, another ABI
+// version, a table of the wrong size and a failing create. The plugin's output is validated
+// against the world: non-finite numbers, tasks outside the bounds, in or too near an obstacle,
+// in unknown space or unreachable are rejected one by one, logged in PlanResult, and the rest
+// kept. A plan call slower than its budget is measured and flagged, not interrupted.
+#include <Eigen/Core>
+#include <cstdint>
+#include <filesystem>
+#include <memory>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "core/status.h"
+#include "plugins/host/planner_world.h"
+#include "plugins/planner_api.h"
+
+namespace voxplan {
+
+struct PlannerLoadOptions {
+  std::string config_json = "{}";
+  uint64_t seed = 0;
+  // Folders searched for a planner given by name; empty means DefaultPlannerSearchPath().
+  std::vector<std::filesystem::path> search_path;
+};
+
+// $VOXPLAN_PLANNER_PATH entries, then the build's planner folder.
+std::vector<std::filesystem::path> DefaultPlannerSearchPath();
+// Names of the libvoxplan_planner_<name>.so files in the folders, sorted, without duplicates.
+std::vector<std::string> AvailablePlanners(const std::vector<std::filesystem::path>& search_path);
+
+struct PlanRequest {
+  PlanEvent event = PlanEvent::kStart;
+  int32_t event_robot = -1;  // robot index the event concerns
+  uint32_t call_index = 0;
+  uint64_t seed = 0;
+  double time_budget_s = 0.0;  // <= 0: none
+  double sim_time_s = 0.0;
+  PlannerTask failed_task;  // for kTaskFailed
+};
+
+struct PathPoint {
+  Eigen::Vector2f position_m = Eigen::Vector2f::Zero();
+  float theta_rad = 0.f;
+};
+struct CameraSample {
+  float t_s = 0.f;
+  Eigen::Vector3f position_m = Eigen::Vector3f::Zero();
+  float yaw_rad = 0.f, pitch_rad = 0.f;
+};
+
+struct RobotPlan {
+  TaskPolicy policy = TaskPolicy::kAppend;
+  std::vector<PlannerTask> tasks;  // validated, in the plugin's order
+  std::vector<PathPoint> path;     // optional dense path
+  std::vector<CameraSample> camera_trajectory;
+};
+
+struct DebugDrawing {
+  enum class Kind { kPoints, kPolyline, kLabel };
+  Kind kind = Kind::kPoints;
+  std::string layer;
+  std::vector<Eigen::Vector3f> points;  // one for a label
+  std::string text;
+  uint32_t rgba = 0xffffffffu;
+};
+
+// Something of the plugin's output the host threw away: a task (task >= 0), or a path, camera
+// trajectory, diagnostic or drawing (task = -1).
+struct Rejection {
+  int32_t robot = -1;
+  int32_t task = -1;
+  std::string reason;
+};
+
+struct PlanLogEntry {
+  int32_t level = VP_LOG_INFO;
+  std::string message;
+};
+
+struct PlanResult {
+  std::vector<RobotPlan> robots;  // one per robot of the world, by index
+  bool done = false;
+  std::vector<std::pair<std::string, double>> diagnostics;  // in the order given
+  std::vector<DebugDrawing> drawings;
+  std::vector<Rejection> rejections;
+  std::vector<PlanLogEntry> log;  // the plugin's messages, then the host's rejections
+  double elapsed_ms = 0.0;
+  bool over_budget = false;
+};
+
+struct PlanValidation {
+  // A task needs this much clearance beyond the robot's radius.
+  float clearance_margin_m = 0.f;
+  float max_dwell_s = 600.f;
+};
+
+// A loaded plugin with one planner instance; destroys the instance and unloads on destruction.
+class LoadedPlanner {
+ public:
+  LoadedPlanner(const LoadedPlanner&) = delete;
+  LoadedPlanner& operator=(const LoadedPlanner&) = delete;
+  ~LoadedPlanner();
+
+  const std::string& name() const { return name_; }
+  const std::string& version() const { return version_; }
+  const std::filesystem::path& path() const { return path_; }
+
+  // One planning call. An error Status when the plugin's plan fails (with its message); the
+  // output's problems are rejections inside the result instead.
+  Result<PlanResult> Plan(const PlannerWorld& world, const PlanRequest& request,
+                          const PlanValidation& validation = {});
+
+ private:
+  friend Result<std::unique_ptr<LoadedPlanner>> LoadPlanner(const std::string&,
+                                                            const PlannerLoadOptions&);
+  LoadedPlanner() = default;
+
+  void* library_ = nullptr;
+  vp_planner_api api_{};
+  vp_planner* instance_ = nullptr;
+  std::string name_, version_;
+  std::filesystem::path path_;
+};
+
+// name_or_path: a path (holds a '/' or ends in ".so") or a planner name.
+Result<std::unique_ptr<LoadedPlanner>> LoadPlanner(const std::string& name_or_path,
+                                                   const PlannerLoadOptions& options = {});
+
+// The host's function table handed to every plugin (static storage).
+const vp_host_api& PlannerHostApi();
+
+}  // namespace voxplan

@@ -1,0 +1,56 @@
+// OMT task assignment (§3.3–3.4, §4): minimise eq. 4 — compactness Σ γ(T_k, ω_r), distance
+// γ(R_r, ω_r) and capacity (|Ω_r| - C_r)² — by Lloyd-style alternation with a capacity
+// relaxation, optionally with the compactness-based clustering refinement (δ = 1 m).
+//
+// γ is a geodesic distance given as matrices, so the centroid ω_r is taken as the medoid: the
+// assigned task minimising compactness + distance (the discrete centroid on the scene graph).
+#pragma once
+
+#include <vector>
+
+#include "plugins/omt/types.h"
+
+namespace voxplan::omt {
+
+struct AssignmentProblem {
+  int num_robots = 0;
+  int num_tasks = 0;
+  DistanceMatrix task_task;      // K × K, symmetric
+  DistanceMatrix robot_task;     // R × K
+  std::vector<double> capacity;  // C_r, one per robot
+};
+
+// C_r = K / R · v_r / v_max (§3.4).
+std::vector<double> RobotCapacities(int num_tasks, const std::vector<double>& speeds_mps);
+
+struct AssignmentParams {
+  bool refine = true;    // clustering refinement; off = NoRefine ablation (K = R clusters)
+  double delta_m = 1.0;  // a task farther than δ from its cluster centre seeds a new cluster
+  int max_iterations = 30;
+  // NoRefine only: after Lloyd, move/swap tasks between robots while exact eq. 4 decreases.
+  bool polish = true;
+};
+
+struct Assignment {
+  std::vector<int> task_robot;     // robot per task, -1 when left unassigned (refinement)
+  std::vector<int> task_cluster;   // final cluster per task
+  std::vector<int> cluster_robot;  // robot seeding each cluster, -1 for task-seeded ones
+  int iterations = 0;
+  bool converged = false;
+  double cost = 0.0;  // eq. 4 over robot clusters
+};
+
+// Eq. 4 for a labelling (unassigned tasks, -1, do not enter), each ω_r the best medoid.
+double Eq4Cost(const AssignmentProblem& problem, const std::vector<int>& task_robot);
+
+// Matrix and capacity sizes agree with num_robots / num_tasks.
+Status ValidateProblem(const AssignmentProblem& problem);
+
+// An invalid problem (see ValidateProblem) yields every task unassigned, converged = false.
+Assignment AssignTasks(const AssignmentProblem& problem, const AssignmentParams& params);
+
+// Exact minimum of eq. 4 over all R^K labellings with every task assigned; for tests. Returns
+// an empty assignment when R^K exceeds max_labellings or the problem is invalid.
+Assignment BruteForceAssignment(const AssignmentProblem& problem, long max_labellings = 5000000);
+
+}  // namespace voxplan::omt

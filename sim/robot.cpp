@@ -1,0 +1,201 @@
+#include "sim/robot.h"
+
+#include <Eigen/Geometry>
+#include <algorithm>
+#include <cmath>
+#include <numbers>
+#include <sstream>
+
+namespace voxplan {
+
+namespace {
+
+constexpr float kPi = std::numbers::pi_v<float>;
+
+float Deg2Rad(float deg) { return deg * kPi / 180.f; }
+
+// Wraps an angle difference into (-π, π].
+float WrapAngle(float a) {
+  a = std::remainder(a, 2.f * kPi);
+  return a <= -kPi ? a + 2.f * kPi : a;
+}
+
+std::string Point(const Eigen::Vector2f& p) {
+  std::ostringstream s;
+  s.precision(4);
+  s << "(" << p.x() << ", " << p.y() << ")";
+  return s.str();
+}
+
+Status ValidateMode(const ModeParams& m, const char* name) {
+  if (!(m.max_speed_mps > 0.f) || !(m.max_turn_rate_radps > 0.f))
+    return InvalidArgument(std::string("RobotParams: ") + name + " speeds must be > 0");
+  if (!(m.horizontal_fov_deg > 1.f && m.horizontal_fov_deg < 179.f))
+    return InvalidArgument(std::string("RobotParams: ") + name +
+                           " horizontal_fov_deg must be in (1, 179)");
+  if (!(m.max_range_m > 0.f))
+    return InvalidArgument(std::string("RobotParams: ") + name + " max_range_m must be > 0");
+  return Status::Ok();
+}
+
+}  // namespace
+
+const char* RobotModeName(RobotMode mode) {
+  return mode == RobotMode::kExplorer ? "explorer" : "reconstructor";
+}
+
+ModeParams DefaultModeParams(RobotMode mode) {
+  // Explorer: fast with far, wide vision; reconstructor: slow, close, narrow (Guo 2022 §3).
+  // Speeds around Dong 2019's 0.3 m/s Turtlebots.
+  if (mode == RobotMode::kExplorer) return {0.5f, 1.0f, 90.0f, 5.0f};
+  return {0.2f, 0.5f, 58.0f, 2.5f};
+}
+
+Status RobotParams::Validate() const {
+  if (!(radius_m > 0.f)) return InvalidArgument("RobotParams: radius_m must be > 0");
+  if (!(camera_height_m > 0.f)) return InvalidArgument("RobotParams: camera_height_m must be > 0");
+  if (!(camera_yaw_rate_radps > 0.f) || !(camera_pitch_rate_radps > 0.f))
+    return InvalidArgument("RobotParams: camera joint rates must be > 0");
+  if (!(max_abs_pitch_deg >= 0.f && max_abs_pitch_deg < 90.f))
+    return InvalidArgument("RobotParams: max_abs_pitch_deg must be in [0, 90)");
+  if (!(dwell_s >= 0.f)) return InvalidArgument("RobotParams: dwell_s must be >= 0");
+  if (image_width <= 0 || image_height <= 0)
+    return InvalidArgument("RobotParams: image size must be positive");
+  VOXPLAN_RETURN_IF_ERROR(ValidateMode(explorer, "explorer"));
+  return ValidateMode(reconstructor, "reconstructor");
+}
+
+Pose3f CameraPoseFromState(const RobotState& state, float camera_height_m) {
+  const float psi = state.heading_rad + state.camera_yaw_rad;
+  const float phi = state.camera_pitch_rad;
+  const Eigen::Vector3f forward(std::cos(phi) * std::cos(psi), std::cos(phi) * std::sin(psi),
+                                std::sin(phi));
+  const Eigen::Vector3f right(std::sin(psi), -std::cos(psi), 0.f);
+  const Eigen::Vector3f down = forward.cross(right);  // OpenCV: x right, y down, z forward
+  Pose3f T_W_C = Pose3f::Identity();
+  T_W_C.linear().col(0) = right;
+  T_W_C.linear().col(1) = down;
+  T_W_C.linear().col(2) = forward;
+  T_W_C.translation() =
+      Eigen::Vector3f(state.position_W.x(), state.position_W.y(), camera_height_m);
+  return T_W_C;
+}
+
+PinholeCamera CameraWithFov(int width, int height, float horizontal_fov_deg) {
+  const float f = 0.5f * float(width) / std::tan(0.5f * Deg2Rad(horizontal_fov_deg));
+  return {width, height, f, f, 0.5f * float(width - 1), 0.5f * float(height - 1)};
+}
+
+bool FootprintFree(const FloorPlan& plan, const Eigen::Vector2f& p_W, float radius_m) {
+  if (plan.width <= 0 || plan.height <= 0 || !p_W.allFinite()) return false;
+  const float res = plan.resolution_m;
+  const Eigen::Vector2f lo =
+      (p_W - plan.origin_W) / res - Eigen::Vector2f::Constant(radius_m / res);
+  const Eigen::Vector2f hi =
+      (p_W - plan.origin_W) / res + Eigen::Vector2f::Constant(radius_m / res);
+  const int x0 = int(std::floor(lo.x() - 0.5f)), x1 = int(std::ceil(hi.x() - 0.5f));
+  const int y0 = int(std::floor(lo.y() - 0.5f)), y1 = int(std::ceil(hi.y() - 0.5f));
+  const float r2 = radius_m * radius_m;
+  bool any = false;
+  for (int y = y0; y <= y1; ++y)
+    for (int x = x0; x <= x1; ++x) {
+      if ((plan.CellCenter(x, y) - p_W).squaredNorm() > r2) continue;
+      any = true;
+      if (!plan.Contains(x, y) || plan.at(x, y) != FloorCell::kFree) return false;
+    }
+  if (!any) {  // footprint smaller than a cell: the cell under the centre decides
+    const Eigen::Vector2f c = (p_W - plan.origin_W) / res;
+    const int x = int(std::floor(c.x())), y = int(std::floor(c.y()));
+    return plan.Contains(x, y) && plan.at(x, y) == FloorCell::kFree;
+  }
+  return true;
+}
+
+bool SegmentFree(const FloorPlan& plan, const Eigen::Vector2f& a_W, const Eigen::Vector2f& b_W,
+                 float radius_m) {
+  const float length = (b_W - a_W).norm();
+  const int steps = std::max(1, int(std::ceil(length / (0.25f * plan.resolution_m))));
+  for (int i = 0; i <= steps; ++i)
+    if (!FootprintFree(plan, a_W + (b_W - a_W) * (float(i) / float(steps)), radius_m)) return false;
+  return true;
+}
+
+Result<Robot> Robot::Create(const RobotParams& params, FloorPlan plan, const RobotState& start,
+                            RobotMode mode) {
+  VOXPLAN_RETURN_IF_ERROR(params.Validate());
+  if (plan.width <= 0 || plan.height <= 0 ||
+      plan.cells.size() != size_t(plan.width) * size_t(plan.height))
+    return InvalidArgument("Robot: empty or inconsistent floor plan");
+  if (!FootprintFree(plan, start.position_W, params.radius_m))
+    return InvalidArgument("Robot: start " + Point(start.position_W) + " with radius " +
+                           std::to_string(params.radius_m) +
+                           " m overlaps an obstacle or lies outside the floor plan");
+  if (std::abs(start.camera_pitch_rad) > Deg2Rad(params.max_abs_pitch_deg))
+    return InvalidArgument("Robot: start camera pitch beyond max_abs_pitch_deg");
+  Robot robot;
+  robot.params_ = params;
+  robot.plan_ = std::move(plan);
+  robot.state_ = start;
+  robot.mode_ = mode;
+  return robot;
+}
+
+void Robot::TurnTo(float heading_rad) {
+  const float delta = WrapAngle(heading_rad - state_.heading_rad);
+  clock_s_ += std::abs(delta) / mode_params().max_turn_rate_radps;
+  state_.heading_rad += delta;
+}
+
+Status Robot::DriveTo(const Eigen::Vector2f& goal_W) {
+  const Eigen::Vector2f delta = goal_W - state_.position_W;
+  const float length = delta.norm();
+  if (!goal_W.allFinite()) return InvalidArgument("Robot::DriveTo: goal is not finite");
+  if (length == 0.f) return Status::Ok();
+  if (!SegmentFree(plan_, state_.position_W, goal_W, params_.radius_m))
+    return InvalidArgument("Robot::DriveTo: path " + Point(state_.position_W) + " -> " +
+                           Point(goal_W) + " collides with the floor plan");
+  TurnTo(std::atan2(delta.y(), delta.x()));
+  clock_s_ += length / mode_params().max_speed_mps;
+  distance_m_ += length;
+  state_.position_W = goal_W;
+  return Status::Ok();
+}
+
+void Robot::SetCameraYaw(float yaw_rad) {
+  clock_s_ += std::abs(yaw_rad - state_.camera_yaw_rad) / params_.camera_yaw_rate_radps;
+  state_.camera_yaw_rad = yaw_rad;
+}
+
+void Robot::WrapCameraYaw() { state_.camera_yaw_rad = WrapAngle(state_.camera_yaw_rad); }
+
+Status Robot::SetCameraPitch(float pitch_rad) {
+  if (!(std::abs(pitch_rad) <= Deg2Rad(params_.max_abs_pitch_deg)))
+    return InvalidArgument("Robot::SetCameraPitch: " + std::to_string(pitch_rad * 180.f / kPi) +
+                           " deg is beyond the limit of " +
+                           std::to_string(params_.max_abs_pitch_deg) + " deg");
+  clock_s_ += std::abs(pitch_rad - state_.camera_pitch_rad) / params_.camera_pitch_rate_radps;
+  state_.camera_pitch_rad = pitch_rad;
+  return Status::Ok();
+}
+
+PinholeCamera Robot::camera() const {
+  return CameraWithFov(params_.image_width, params_.image_height, mode_params().horizontal_fov_deg);
+}
+
+bool FusionTrigger::ShouldFuse(const Pose3f& T_W_C) {
+  bool fire = !has_last_;
+  if (!fire) {
+    const float moved = (T_W_C.translation() - last_T_W_C_.translation()).norm();
+    const Eigen::AngleAxisf turned(last_T_W_C_.linear().transpose() * T_W_C.linear());
+    fire = moved > params_.min_translation_m ||
+           std::abs(turned.angle()) > Deg2Rad(params_.min_rotation_deg);
+  }
+  if (fire) {
+    has_last_ = true;
+    last_T_W_C_ = T_W_C;
+    ++fired_;
+  }
+  return fire;
+}
+
+}  // namespace voxplan

@@ -1,0 +1,128 @@
+#pragma once
+// A simulated ground robot carrying an RGB-D camera: an SE(2) base (x, y, θ) with a round
+// footprint, a camera at fixed height on a yaw joint (Dong et al. 2019: the camera heading is
+// independent of the direction of motion) with an optional pitch, and two scanning modes
+// (Guo et al. 2022): a fast, far-seeing explorer and a slow, close, narrow reconstructor.
+// Motion is checked against the world's true FloorPlan and timed on a simulation clock.
+#include <Eigen/Core>
+#include <cstdint>
+#include <string>
+
+#include "core/camera.h"
+#include "core/pose.h"
+#include "core/status.h"
+#include "sim/floor_plan.h"
+
+namespace voxplan {
+
+enum class RobotMode { kExplorer, kReconstructor };
+const char* RobotModeName(RobotMode mode);  // "explorer", "reconstructor"
+
+// What a mode changes: speeds and the sensor's field of view and range.
+struct ModeParams {
+  float max_speed_mps = 0.5f;
+  float max_turn_rate_radps = 1.0f;  // base, turning in place
+  float horizontal_fov_deg = 90.0f;
+  float max_range_m = 5.0f;
+};
+ModeParams DefaultModeParams(RobotMode mode);
+
+struct RobotParams {
+  float radius_m = 0.2f;         // round footprint
+  float camera_height_m = 1.2f;  // optical centre above the floor (z = 0)
+  float camera_yaw_rate_radps = 1.5f;
+  float camera_pitch_rate_radps = 1.0f;
+  float max_abs_pitch_deg = 60.0f;
+  float dwell_s = 0.2f;  // standing still per captured view
+  int image_width = 640, image_height = 480;
+  ModeParams explorer = DefaultModeParams(RobotMode::kExplorer);
+  ModeParams reconstructor = DefaultModeParams(RobotMode::kReconstructor);
+
+  Status Validate() const;
+  const ModeParams& mode(RobotMode m) const {
+    return m == RobotMode::kExplorer ? explorer : reconstructor;
+  }
+};
+
+struct RobotState {
+  Eigen::Vector2f position_W = Eigen::Vector2f::Zero();  // base centre on the floor, metres
+  float heading_rad = 0.f;                               // base θ, from world +x towards +y
+  float camera_yaw_rad = 0.f;    // joint angle relative to the base (unwrapped)
+  float camera_pitch_rad = 0.f;  // positive looks up
+};
+
+// Camera-to-world pose of the camera (OpenCV axes: x right, y down, z forward) for a state.
+Pose3f CameraPoseFromState(const RobotState& state, float camera_height_m);
+// Square-pixel camera with the given horizontal field of view, principal point at the centre.
+PinholeCamera CameraWithFov(int width, int height, float horizontal_fov_deg);
+
+// True when every plan cell whose centre lies within radius_m of p_W is free (cells outside the
+// plan count as blocked).
+bool FootprintFree(const FloorPlan& plan, const Eigen::Vector2f& p_W, float radius_m);
+// True when the footprint is free at every point of the segment (sampled every quarter cell).
+bool SegmentFree(const FloorPlan& plan, const Eigen::Vector2f& a_W, const Eigen::Vector2f& b_W,
+                 float radius_m);
+
+class Robot {
+ public:
+  // Refuses invalid params and a start pose whose footprint is not free.
+  static Result<Robot> Create(const RobotParams& params, FloorPlan plan, const RobotState& start,
+                              RobotMode mode = RobotMode::kExplorer);
+
+  const RobotState& state() const { return state_; }
+  const RobotParams& params() const { return params_; }
+  const FloorPlan& plan() const { return plan_; }
+  RobotMode mode() const { return mode_; }
+  const ModeParams& mode_params() const { return params_.mode(mode_); }
+  double clock_s() const { return clock_s_; }
+  double distance_m() const { return distance_m_; }
+
+  void SetMode(RobotMode mode) { mode_ = mode; }
+  // Turns the base in place to `heading_rad` the short way; costs |Δθ| / turn rate.
+  void TurnTo(float heading_rad);
+  // Turns towards the goal, then drives straight at the mode's speed. Refuses (state and clock
+  // unchanged) a goal whose straight segment the footprint cannot pass.
+  Status DriveTo(const Eigen::Vector2f& goal_W);
+  // Camera joints; each costs |Δangle| / joint rate. Pitch beyond the limit is refused.
+  void SetCameraYaw(float yaw_rad);
+  Status SetCameraPitch(float pitch_rad);
+  // The yaw joint turns without end: drops whole turns from its angle, taking no time.
+  void WrapCameraYaw();
+  // Stands still for the dwell time of one view.
+  void Dwell() { clock_s_ += params_.dwell_s; }
+
+  Pose3f T_W_C() const { return CameraPoseFromState(state_, params_.camera_height_m); }
+  // The current mode's camera (field of view) at the robot's image size.
+  PinholeCamera camera() const;
+
+ private:
+  Robot() = default;
+  RobotParams params_;
+  FloorPlan plan_;
+  RobotState state_;
+  RobotMode mode_ = RobotMode::kExplorer;
+  double clock_s_ = 0.0;
+  double distance_m_ = 0.0;
+};
+
+// Fires for the first pose, then whenever the camera has moved more than min_translation_m or
+// turned more than min_rotation_deg since the last pose it fired for.
+struct FusionTriggerParams {
+  float min_translation_m = 0.1f;
+  float min_rotation_deg = 10.0f;
+};
+
+class FusionTrigger {
+ public:
+  explicit FusionTrigger(const FusionTriggerParams& params = {}) : params_(params) {}
+  bool ShouldFuse(const Pose3f& T_W_C);  // true: the caller fuses this frame
+  size_t fired() const { return fired_; }
+
+ private:
+  FusionTriggerParams params_;
+  bool has_last_ = false;
+  Pose3f last_T_W_C_ = Pose3f::Identity();
+  size_t fired_ = 0;
+};
+
+}  // namespace voxplan

@@ -1,0 +1,347 @@
+// The planner plugin boundary: loading by name and path, refusal of incompatible or broken
+// modules with a message (never a crash), exceptions turned into statuses, validation of what a
+// plugin returns, the time budget, and determinism for a seed.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdlib>
+#include <fstream>
+#include <map>
+#include <string>
+
+#include "plugins/host/plugin_host.h"
+#include "plugins/planner_cpp.h"
+#include "tests/plugins/fake_world.h"
+#include "tests/support/test_support.h"
+
+namespace voxplan {
+namespace {
+
+const std::filesystem::path kDir = VOXPLAN_TEST_PLANNER_DIR;
+
+PlannerLoadOptions Options(const std::string& config = "{}", uint64_t seed = 0) {
+  PlannerLoadOptions o;
+  o.config_json = config;
+  o.seed = seed;
+  o.search_path = {kDir};
+  return o;
+}
+
+std::unique_ptr<LoadedPlanner> MustLoad(const std::string& name, const std::string& config = "{}",
+                                        uint64_t seed = 0) {
+  auto planner = LoadPlanner(name, Options(config, seed));
+  EXPECT_TRUE(planner.ok()) << planner.status().message();
+  return planner.ok() ? std::move(planner).value() : nullptr;
+}
+
+std::map<std::string, double> Diagnostics(const PlanResult& r) {
+  return {r.diagnostics.begin(), r.diagnostics.end()};
+}
+
+bool Contains(const std::string& s, const std::string& part) {
+  return s.find(part) != std::string::npos;
+}
+
+TEST(PluginHost, LoadsByNameAndPlansToReachableFrontiers) {
+  auto planner = MustLoad("minimal");
+  ASSERT_TRUE(planner);
+  EXPECT_EQ(planner->name(), "minimal");
+  EXPECT_EQ(planner->version(), "1.0.0");
+  const test::FakeWorld world;
+  auto result = planner->Plan(world, {});
+  ASSERT_TRUE(result.ok()) << result.status().message();
+  EXPECT_TRUE(result->rejections.empty());
+  ASSERT_EQ(result->robots.size(), 2u);
+  for (size_t r = 0; r < 2; ++r) {
+    const RobotPlan& plan = result->robots[r];
+    EXPECT_EQ(plan.policy, TaskPolicy::kReplace);
+    ASSERT_EQ(plan.tasks.size(), 1u);
+    EXPECT_EQ(world.CellAt(plan.tasks[0].position_m), FloorCell::kFrontier);
+    ASSERT_GE(plan.path.size(), 2u);
+    EXPECT_TRUE(plan.path.front().position_m.isApprox(world.Robots()[r].position_m));
+    EXPECT_TRUE(plan.path.back().position_m.isApprox(plan.tasks[0].position_m));
+  }
+  const auto d = Diagnostics(*result);
+  EXPECT_GT(d.at("frontier_cells"), 0.0);
+  EXPECT_GE(d.at("plan_ms"), 0.0);
+  EXPECT_FALSE(result->done);
+  EXPECT_EQ(result->drawings.size(), 4u);  // a path and a label per robot
+  EXPECT_FALSE(result->over_budget);
+}
+
+TEST(PluginHost, LoadsByPath) {
+  auto planner = LoadPlanner((kDir / "libvoxplan_planner_minimal.so").string());
+  ASSERT_TRUE(planner.ok()) << planner.status().message();
+  EXPECT_EQ((*planner)->name(), "minimal");
+}
+
+TEST(PluginHost, LoadsAPlainCPlanner) {
+  auto planner = MustLoad("c_minimal");
+  ASSERT_TRUE(planner);
+  const test::FakeWorld world;
+  auto result = planner->Plan(world, {});
+  ASSERT_TRUE(result.ok()) << result.status().message();
+  EXPECT_TRUE(result->done);
+  EXPECT_EQ(Diagnostics(*result).at("robots"), 2.0);
+}
+
+TEST(PluginHost, RefusesAnotherAbiVersionNamingBoth) {
+  auto planner = LoadPlanner("abi2", Options());
+  ASSERT_FALSE(planner.ok());
+  EXPECT_EQ(planner.status().code(), StatusCode::kUnsupported);
+  EXPECT_TRUE(Contains(planner.status().message(), "built for planner ABI 2"))
+      << planner.status().message();
+  EXPECT_TRUE(Contains(planner.status().message(), "this voxplan speaks ABI 1"));
+}
+
+TEST(PluginHost, RefusesAWrongTableSize) {
+  auto planner = LoadPlanner("badsize", Options());
+  ASSERT_FALSE(planner.ok());
+  EXPECT_EQ(planner.status().code(), StatusCode::kUnsupported);
+  const std::string expected = std::to_string(sizeof(vp_planner_api));
+  EXPECT_TRUE(Contains(planner.status().message(), "expects " + expected))
+      << planner.status().message();
+}
+
+TEST(PluginHost, RefusesAModuleWithoutEntrySymbol) {
+  auto planner = LoadPlanner("noentry", Options());
+  ASSERT_FALSE(planner.ok());
+  EXPECT_TRUE(Contains(planner.status().message(), "no vp_planner_entry symbol"))
+      << planner.status().message();
+}
+
+TEST(PluginHost, RefusesMissingAndNonLibraryFiles) {
+  auto missing = LoadPlanner("/nonexistent/libvoxplan_planner_x.so");
+  ASSERT_FALSE(missing.ok());
+  EXPECT_EQ(missing.status().code(), StatusCode::kNotFound);
+
+  test::TempDir dir("planner_host");
+  const std::filesystem::path fake = dir / "libvoxplan_planner_text.so";
+  std::ofstream(fake) << "not an ELF file\n";
+  auto text = LoadPlanner(fake.string());
+  ASSERT_FALSE(text.ok());
+  EXPECT_EQ(text.status().code(), StatusCode::kIoError);
+  EXPECT_TRUE(Contains(text.status().message(), "cannot load planner"));
+}
+
+TEST(PluginHost, UnknownNameListsTheAvailablePlanners) {
+  auto planner = LoadPlanner("nosuch", Options());
+  ASSERT_FALSE(planner.ok());
+  EXPECT_EQ(planner.status().code(), StatusCode::kNotFound);
+  const std::string& m = planner.status().message();
+  EXPECT_TRUE(Contains(m, "unknown planner 'nosuch'")) << m;
+  EXPECT_TRUE(Contains(m, "garbage, minimal, noentry, probe, throwing")) << m;
+  const std::vector<std::string> names = AvailablePlanners({kDir});
+  EXPECT_EQ(names.front(), "abi2");  // sorted
+  // A name never becomes a path outside the search path.
+  EXPECT_FALSE(LoadPlanner("..", Options()).ok());
+}
+
+TEST(PluginHost, SearchPathComesFromTheEnvironmentFirst) {
+  ASSERT_EQ(setenv("VOXPLAN_PLANNER_PATH", (kDir.string() + ":/nowhere").c_str(), 1), 0);
+  const std::vector<std::filesystem::path> path = DefaultPlannerSearchPath();
+  ASSERT_GE(path.size(), 2u);
+  EXPECT_EQ(path[0], kDir);
+  EXPECT_EQ(path[1], "/nowhere");
+  auto planner = LoadPlanner("minimal");
+  unsetenv("VOXPLAN_PLANNER_PATH");
+  EXPECT_TRUE(planner.ok()) << planner.status().message();
+}
+
+TEST(PluginHost, CreateFailureIsReportedWithThePluginsMessage) {
+  auto refused = LoadPlanner("minimal", Options(R"({"fail": true})"));
+  ASSERT_FALSE(refused.ok());
+  EXPECT_TRUE(Contains(refused.status().message(), "option fail is set"))
+      << refused.status().message();
+  auto thrown = LoadPlanner("throwing", Options("create"));
+  ASSERT_FALSE(thrown.ok());
+  EXPECT_TRUE(Contains(thrown.status().message(), "refusing to be created"));
+}
+
+TEST(PluginHost, ExceptionsInPlanBecomeStatuses) {
+  const test::FakeWorld world;
+  auto planner = MustLoad("throwing");
+  ASSERT_TRUE(planner);
+  for (int i = 0; i < 2; ++i) {  // the instance stays usable after a failure
+    auto result = planner->Plan(world, {});
+    ASSERT_FALSE(result.ok());
+    EXPECT_TRUE(Contains(result.status().message(), "boom in plan")) << result.status().message();
+    EXPECT_TRUE(Contains(result.status().message(), "status 6"));
+  }
+  auto non_std = MustLoad("throwing", "int");
+  ASSERT_TRUE(non_std);
+  auto result = non_std->Plan(world, {});
+  ASSERT_FALSE(result.ok());
+  EXPECT_TRUE(Contains(result.status().message(), "unknown exception"));
+  // A bad query argument comes back as a host status, which the C++ layer rethrows.
+  auto bad_query = MustLoad("throwing", "bad_robot");
+  ASSERT_TRUE(bad_query);
+  result = bad_query->Plan(world, {});
+  ASSERT_FALSE(result.ok());
+  EXPECT_TRUE(Contains(result.status().message(), "get_robot failed with status 1"))
+      << result.status().message();
+}
+
+TEST(PluginHost, GarbageIsRejectedAndLoggedAndTheRestKept) {
+  const test::FakeWorld world;
+  auto planner = MustLoad("garbage");
+  ASSERT_TRUE(planner);
+  auto result = planner->Plan(world, {});
+  ASSERT_TRUE(result.ok()) << result.status().message();
+  const RobotPlan& plan = result->robots[0];
+  ASSERT_EQ(plan.tasks.size(), 1u);
+  EXPECT_EQ(plan.tasks[0].tag, 1u);
+  EXPECT_TRUE(plan.path.empty());  // it held an infinity
+
+  std::map<int, std::string> task_reasons;
+  int other = 0;
+  for (const Rejection& r : result->rejections) {
+    if (r.task >= 0) {
+      EXPECT_EQ(r.robot, 0);
+      task_reasons[r.task] = r.reason;
+    } else {
+      ++other;
+    }
+  }
+  ASSERT_EQ(task_reasons.size(), 8u);
+  EXPECT_TRUE(Contains(task_reasons[0], "non-finite"));
+  EXPECT_TRUE(Contains(task_reasons[2], "inside an obstacle"));
+  EXPECT_TRUE(Contains(task_reasons[3], "unknown space"));
+  EXPECT_TRUE(Contains(task_reasons[4], "too close to an obstacle"));
+  EXPECT_TRUE(Contains(task_reasons[5], "unreachable"));
+  EXPECT_TRUE(Contains(task_reasons[6], "outside the map bounds"));
+  EXPECT_TRUE(Contains(task_reasons[7], "mode 7 unknown"));
+  EXPECT_TRUE(Contains(task_reasons[8], "dwell"));
+  EXPECT_EQ(other, 3);  // the path, the NaN diagnostic, the NaN drawing
+  const auto d = Diagnostics(*result);
+  EXPECT_EQ(d.count("energy"), 0u);
+  EXPECT_EQ(d.at("iterations"), 3.0);
+  EXPECT_TRUE(result->drawings.empty());
+  int warnings = 0;
+  for (const PlanLogEntry& e : result->log) warnings += e.level == VP_LOG_WARNING;
+  EXPECT_EQ(warnings, int(result->rejections.size()));
+}
+
+TEST(PluginHost, QueriesReachThePluginUnchanged) {
+  test::FakeWorld world;
+  auto planner = MustLoad("probe", "{}", 5);
+  ASSERT_TRUE(planner);
+  PlanRequest request;
+  request.event = PlanEvent::kTaskFailed;
+  request.event_robot = 1;
+  request.call_index = 3;
+  request.seed = 77;
+  request.time_budget_s = 2.0;
+  request.failed_task.tag = 12;
+  auto result = planner->Plan(world, request);
+  ASSERT_TRUE(result.ok()) << result.status().message();
+  const auto d = Diagnostics(*result);
+  EXPECT_EQ(d.at("create_seed"), 5.0);
+  EXPECT_EQ(d.at("event"), VP_EVENT_TASK_FAILED);
+  EXPECT_EQ(d.at("event_robot"), 1.0);
+  EXPECT_EQ(d.at("call_index"), 3.0);
+  EXPECT_EQ(d.at("call_seed"), 77.0);
+  EXPECT_EQ(d.at("budget_s"), 2.0);
+  EXPECT_EQ(d.at("failed_tag"), 12.0);
+  EXPECT_EQ(d.at("revision"), 42.0);
+  EXPECT_FLOAT_EQ(float(d.at("voxel_size_m")), 0.05f);
+  EXPECT_FLOAT_EQ(float(d.at("bounds_max_x")), 5.f);
+  EXPECT_EQ(d.at("state_0"), VP_VOXEL_OCCUPIED);
+  EXPECT_EQ(d.at("state_1"), VP_VOXEL_FREE);
+  EXPECT_EQ(d.at("state_2"), VP_VOXEL_UNOBSERVED);
+  EXPECT_NEAR(d.at("ray_distance"), 0.85, 0.02);
+  EXPECT_EQ(d.at("ray_result"), VP_RAY_SURFACE);
+  EXPECT_EQ(d.at("frontier_voxels"), double(world.FrontierVoxels().size()));
+  EXPECT_EQ(d.at("surface_voxels"), double(world.SurfaceVoxels().size()));
+  EXPECT_NEAR(d.at("surface_normal_norm"), 1.0, 1e-6);
+  EXPECT_EQ(d.at("floor_width"), test::FakeWorld::kWidth);
+  EXPECT_EQ(d.at("floor_cell_0"), VP_FLOOR_OBSTACLE);
+  EXPECT_EQ(d.at("instances"), 1.0);
+  EXPECT_EQ(d.at("instance_label_is_chair"), 1.0);
+  EXPECT_EQ(d.at("robots"), 2.0);
+  EXPECT_EQ(d.at("robot1_id"), 11.0);
+  EXPECT_EQ(d.at("robot1_status"), VP_ROBOT_EXECUTING);
+  EXPECT_EQ(d.at("robot1_modes"), 2.0);
+  EXPECT_EQ(d.at("robot1_queue_tag"), 99.0);
+  EXPECT_FLOAT_EQ(float(d.at("reconstructor_speed")), 0.2f);
+  // Geodesic distances are symmetric, zero on the diagonal, and at least the straight line.
+  EXPECT_EQ(d.at("d00"), 0.0);
+  EXPECT_TRUE(std::isfinite(d.at("d01")));
+  EXPECT_NEAR(d.at("d01"), d.at("d10"), 1e-4);
+  const float straight = (world.Robots()[0].position_m - world.Robots()[1].position_m).norm();
+  EXPECT_GE(d.at("d01"), straight);
+  ASSERT_FALSE(result->log.empty());
+  EXPECT_EQ(result->log[0].message, "probe done");
+}
+
+TEST(PluginHost, DeterministicForASeed) {
+  const test::FakeWorld world;
+  const std::string config = R"({"candidates": 6})";
+  auto plan = [&](uint64_t create_seed, uint64_t call_seed) {
+    auto planner = MustLoad("minimal", config, create_seed);
+    PlanRequest request;
+    request.seed = call_seed;
+    auto result = planner->Plan(world, request);
+    EXPECT_TRUE(result.ok());
+    std::vector<uint32_t> tags;
+    for (const RobotPlan& p : result->robots) {
+      for (const PlannerTask& t : p.tasks) tags.push_back(t.tag);
+    }
+    return tags;
+  };
+  const std::vector<uint32_t> reference = plan(3, 11);
+  ASSERT_EQ(reference.size(), 2u);
+  for (int i = 0; i < 3; ++i) EXPECT_EQ(plan(3, 11), reference);
+  // The seed matters: among a few other seeds some pick other frontier cells.
+  bool any_differs = false;
+  for (uint64_t seed = 0; seed < 8; ++seed)
+    any_differs = any_differs || plan(seed, 11) != reference;
+  EXPECT_TRUE(any_differs);
+}
+
+TEST(PluginHost, OverBudgetCallsAreFlagged) {
+  const test::FakeWorld world;
+  auto planner = MustLoad("minimal", R"({"sleep_ms": 30})");
+  ASSERT_TRUE(planner);
+  PlanRequest request;
+  request.time_budget_s = 0.005;
+  auto slow = planner->Plan(world, request);
+  ASSERT_TRUE(slow.ok());
+  EXPECT_TRUE(slow->over_budget);
+  EXPECT_GE(slow->elapsed_ms, 30.0);
+  ASSERT_FALSE(slow->log.empty());
+  EXPECT_TRUE(Contains(slow->log.back().message, "over its budget"));
+  EXPECT_EQ(slow->robots[0].tasks.size(), 1u);  // the plan itself is kept
+  request.time_budget_s = 0.0;                  // no budget: never over it
+  auto unbounded = planner->Plan(world, request);
+  ASSERT_TRUE(unbounded.ok());
+  EXPECT_FALSE(unbounded->over_budget);
+}
+
+// The plugin side of the handshake (planner_cpp.h), called directly.
+class Nothing : public vp::Planner {
+ public:
+  explicit Nothing(const vp::Config&) {}
+  void Plan(const vp::WorldView&, vp::PlanOutput&) override {}
+};
+
+TEST(PluginCppLayer, EntryRefusesAnotherHostAbiOrAShortHostTable) {
+  vp_planner_api api{};
+  api.struct_size = sizeof(api);
+  EXPECT_EQ(vp::detail::Entry<Nothing>(2, &PlannerHostApi(), &api, "n", "1"),
+            VP_ERROR_ABI_MISMATCH);
+  EXPECT_EQ(api.abi_version, VP_PLANNER_ABI_VERSION);  // written even on refusal
+  vp_host_api short_host = PlannerHostApi();
+  short_host.struct_size = sizeof(vp_host_api) - sizeof(void*);
+  EXPECT_EQ(vp::detail::Entry<Nothing>(1, &short_host, &api, "n", "1"), VP_ERROR_STRUCT_SIZE);
+  // An older host with a shorter planner table gets only the prefix it asked for.
+  vp_planner_api prefix{};
+  prefix.struct_size = offsetof(vp_planner_api, create);
+  EXPECT_EQ(vp::detail::Entry<Nothing>(1, &PlannerHostApi(), &prefix, "n", "1"), VP_OK);
+  EXPECT_EQ(prefix.struct_size, offsetof(vp_planner_api, create));
+  EXPECT_EQ(prefix.create, nullptr);
+  EXPECT_STREQ(prefix.name, "n");
+}
+
+}  // namespace
+}  // namespace voxplan
