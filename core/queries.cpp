@@ -16,13 +16,14 @@ std::optional<VoxelValue> VoxelAtPoint(const TsdfVolume& volume, const Eigen::Ve
   return VoxelAtIndex(volume, VoxelAt(p_W, volume.voxel_size_m()));
 }
 
-VoxelState StateAt(const TsdfVolume& volume, const Eigen::Vector3f& p_W) {
+VoxelState StateAt(const TsdfVolume& volume, const Eigen::Vector3f& p_W,
+                   const VoxelStateParams& params) {
   const GlobalVoxelIndex g = VoxelAt(p_W, volume.voxel_size_m());
   const TsdfBlock* block = volume.FindBlock(BlockOf(g));
   if (!block) return VoxelState::kUnobserved;
   const int i = LinearIndex(LocalOf(g));
-  if (block->weight[i] == 0) return VoxelState::kUnobserved;
-  return block->tsdf[i] >= int16_t(kTsdfScale) ? VoxelState::kFree : VoxelState::kNearSurface;
+  return ClassifyVoxel(block->tsdf[i], block->weight[i], volume.trunc_m() / volume.voxel_size_m(),
+                       params);
 }
 
 std::optional<VoxelValue> Interpolate(const TsdfVolume& volume, const Eigen::Vector3f& p_W,

@@ -5,10 +5,9 @@
 #include <optional>
 
 #include "core/volume.h"
+#include "core/voxel_state.h"
 
 namespace voxplan {
-
-enum class VoxelState : uint8_t { kUnobserved = 0, kFree = 1, kNearSurface = 2 };
 
 struct VoxelValue {
   float tsdf_m = 0.f;  // signed distance, metres (truncated)
@@ -20,9 +19,10 @@ struct VoxelValue {
 std::optional<VoxelValue> VoxelAtPoint(const TsdfVolume& volume, const Eigen::Vector3f& p_W);
 std::optional<VoxelValue> VoxelAtIndex(const TsdfVolume& volume, GlobalVoxelIndex g);
 
-// Unobserved (weight 0 or not allocated), near surface (|tsdf| inside the truncation band),
-// or free (at the positive truncation limit).
-VoxelState StateAt(const TsdfVolume& volume, const Eigen::Vector3f& p_W);
+// The state of the voxel containing p_W by the one rule of core/voxel_state.h; unobserved
+// where its block is not allocated.
+VoxelState StateAt(const TsdfVolume& volume, const Eigen::Vector3f& p_W,
+                   const VoxelStateParams& params = {});
 
 // Trilinear interpolation over the 8 surrounding voxel centres; nullopt unless all 8 are
 // observed with weight >= min_weight.

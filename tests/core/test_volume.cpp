@@ -55,7 +55,10 @@ TEST(Queries, InterpolationAndGradientAreExactOnALinearField) {
   // Outside the allocated blocks: no value, unobserved.
   EXPECT_FALSE(Interpolate(volume, Eigen::Vector3f(0.5f, 0.5f, 0.5f)).has_value());
   EXPECT_EQ(StateAt(volume, Eigen::Vector3f(0.5f, 0.5f, 0.5f)), VoxelState::kUnobserved);
-  EXPECT_EQ(StateAt(volume, Eigen::Vector3f(0.01f, 0.01f, 0.01f)), VoxelState::kNearSurface);
+  // Behind the surface (f = -2 cm, so every point of its voxel has f < 0): occupied; far in
+  // front (f = +5 cm, over a voxel even at its corners): free.
+  EXPECT_EQ(StateAt(volume, (-c - 0.02f) * a / a.squaredNorm()), VoxelState::kOccupied);
+  EXPECT_EQ(StateAt(volume, (-c + 0.05f) * a / a.squaredNorm()), VoxelState::kFree);
 }
 
 TEST(Queries, StateDistinguishesFreeFromUnobserved) {
