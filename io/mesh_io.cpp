@@ -14,6 +14,7 @@
 #include <filesystem>
 #include <memory>
 
+#include "io/assimp_material.h"
 #include "io/file_util.h"
 
 namespace voxplan {
@@ -30,20 +31,6 @@ std::string LowerExtension(const std::string& path) {
 uint8_t ToByte(float c) {
   if (!std::isfinite(c)) return 0;
   return uint8_t(std::lround(std::clamp(c, 0.0f, 1.0f) * 255.0f));
-}
-
-// Importers invent a material when a file has none ("DefaultMaterial", or an unnamed white one
-// for PLY and STL, which have no materials of their own); that is not the file's colour.
-bool MaterialDiffuse(const aiScene& scene, unsigned int index, bool format_has_materials,
-                     aiColor4D* color) {
-  if (!format_has_materials) return false;
-  if (index >= scene.mNumMaterials || !scene.mMaterials[index]) return false;
-  const aiMaterial& material = *scene.mMaterials[index];
-  aiString name;
-  if (material.Get(AI_MATKEY_NAME, name) == AI_SUCCESS &&
-      std::strcmp(name.C_Str(), AI_DEFAULT_MATERIAL_NAME) == 0)
-    return false;
-  return material.Get(AI_MATKEY_COLOR_DIFFUSE, *color) == AI_SUCCESS;
 }
 
 // Binary little-endian PLY written directly: assimp's PLY exporter stores colours as floats
@@ -218,7 +205,7 @@ Result<Mesh> ReadMesh(const std::string& path, const MeshReadOptions& options) {
     any_triangles = true;
     aiColor4D c;
     if (mesh.HasVertexColors(0) ||
-        MaterialDiffuse(*scene, mesh.mMaterialIndex, format_has_materials, &c))
+        internal::MaterialDiffuse(*scene, mesh.mMaterialIndex, format_has_materials, &c))
       any_color = true;
     if (!mesh.HasNormals()) all_normals = false;
   }
@@ -250,7 +237,7 @@ Result<Mesh> ReadMesh(const std::string& path, const MeshReadOptions& options) {
       aiColor4D diffuse(0.6f, 0.6f, 0.6f, 1.0f);  // assimp's own default grey
       const bool has_vertex_colors = mesh.HasVertexColors(0);
       if (!has_vertex_colors)
-        MaterialDiffuse(*scene, mesh.mMaterialIndex, format_has_materials, &diffuse);
+        internal::MaterialDiffuse(*scene, mesh.mMaterialIndex, format_has_materials, &diffuse);
       for (unsigned int v = 0; v < mesh.mNumVertices; ++v) {
         const aiColor4D& c = has_vertex_colors ? mesh.mColors[0][v] : diffuse;
         out.colors.push_back({ToByte(c.r), ToByte(c.g), ToByte(c.b)});
@@ -266,5 +253,21 @@ Result<Mesh> ReadMesh(const std::string& path, const MeshReadOptions& options) {
   if (out.triangles.empty()) return InvalidArgument("mesh file " + path + " holds no triangles");
   return out;
 }
+
+namespace internal {
+
+bool MaterialDiffuse(const aiScene& scene, unsigned int index, bool format_has_materials,
+                     aiColor4D* color) {
+  if (!format_has_materials) return false;
+  if (index >= scene.mNumMaterials || !scene.mMaterials[index]) return false;
+  const aiMaterial& material = *scene.mMaterials[index];
+  aiString name;
+  if (material.Get(AI_MATKEY_NAME, name) == AI_SUCCESS &&
+      std::strcmp(name.C_Str(), AI_DEFAULT_MATERIAL_NAME) == 0)
+    return false;
+  return material.Get(AI_MATKEY_COLOR_DIFFUSE, *color) == AI_SUCCESS;
+}
+
+}  // namespace internal
 
 }  // namespace voxplan

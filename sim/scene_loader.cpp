@@ -16,6 +16,7 @@
 #include <set>
 #include <sstream>
 
+#include "io/assimp_material.h"
 #include "sim/world_io.h"
 
 namespace voxplan {
@@ -227,14 +228,7 @@ struct MeshBuilder {
   }
 
   bool MaterialDiffuse(unsigned int index, aiColor4D* color) const {
-    if (!format_has_materials) return false;
-    if (index >= scene.mNumMaterials || !scene.mMaterials[index]) return false;
-    const aiMaterial& material = *scene.mMaterials[index];
-    aiString name;
-    if (material.Get(AI_MATKEY_NAME, name) == AI_SUCCESS &&
-        std::strcmp(name.C_Str(), AI_DEFAULT_MATERIAL_NAME) == 0)
-      return false;
-    return material.Get(AI_MATKEY_COLOR_DIFFUSE, *color) == AI_SUCCESS;
+    return internal::MaterialDiffuse(scene, index, format_has_materials, color);
   }
 
   static bool IsTriangleMesh(const aiMesh& m) {
