@@ -19,6 +19,22 @@ namespace voxplan::cli {
 
 namespace fs = std::filesystem;
 
+void AddSceneFrameOptions(CLI::App* sub, SceneFrameOptions& frame) {
+  sub->add_option("--up", frame.up, "Scene up axis: z or y (y rotates a Y-up file to Z-up)")
+      ->check(CLI::IsMember({"z", "y", "Z", "Y"}))
+      ->capture_default_str();
+  sub->add_option("--scale", frame.scale, "Scene scale to metres")
+      ->check(Positive())
+      ->capture_default_str();
+}
+
+SceneLoadOptions SceneLoad(const SceneFrameOptions& frame) {
+  SceneLoadOptions load;
+  load.scale = float(frame.scale);
+  load.up = (frame.up == "y" || frame.up == "Y") ? UpAxis::kY : UpAxis::kZ;
+  return load;
+}
+
 int RunParsed(const std::vector<Command>& commands) {
   for (const Command& command : commands) {
     if (command.app->parsed()) return command.run();

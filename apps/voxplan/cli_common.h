@@ -13,6 +13,7 @@
 #include "core/mesh.h"
 #include "core/status.h"
 #include "core/volume.h"
+#include "sim/scene_loader.h"
 
 namespace voxplan::cli {
 
@@ -58,6 +59,15 @@ CLI::Validator MeshOutputValidator();
 // Numeric checks with short messages (CLI11 2.1's own print the whole double range).
 CLI::Validator Positive();
 CLI::Validator NonNegative();
+
+// --up and --scale of a scene file: worlds are Z-up metres unless these say otherwise.
+struct SceneFrameOptions {
+  std::string up = "z";
+  double scale = 1.0;
+};
+void AddSceneFrameOptions(CLI::App* sub, SceneFrameOptions& frame);
+// The load options they ask for (the rest at their defaults).
+SceneLoadOptions SceneLoad(const SceneFrameOptions& frame);
 
 // "fx,fy,cx,cy" -> camera with width/height 0 (the dataset's images give the size).
 Result<PinholeCamera> ParseIntrinsics(const std::string& text);

@@ -24,8 +24,7 @@ namespace fs = std::filesystem;
 struct SceneOptions {
   std::string scene;
   std::string instances;
-  std::string up = "z";
-  double scale = 1.0;
+  SceneFrameOptions frame;
 };
 
 void AddSceneOptions(CLI::App* sub, SceneOptions* s, bool required) {
@@ -33,12 +32,7 @@ void AddSceneOptions(CLI::App* sub, SceneOptions* s, bool required) {
       "--scene", s->scene, "Ground-truth world mesh; its instance table is <stem>_instances.tsv");
   if (required) scene->required();
   sub->add_option("--instances", s->instances, "Instance table of the world (default: beside it)");
-  sub->add_option("--up", s->up, "Up axis of the world file (y rotates to Z-up)")
-      ->check(CLI::IsMember({"y", "z"}))
-      ->capture_default_str();
-  sub->add_option("--scale", s->scale, "Scale of the world file to metres")
-      ->check(Positive())
-      ->capture_default_str();
+  AddSceneFrameOptions(sub, s->frame);
 }
 
 Result<World> LoadScene(const SceneOptions& s) {
@@ -46,9 +40,7 @@ Result<World> LoadScene(const SceneOptions& s) {
   if (!fs::is_regular_file(s.scene, ec)) return NotFound("scene file not found: " + s.scene);
   if (!s.instances.empty() && !fs::is_regular_file(s.instances, ec))
     return NotFound("instance table not found: " + s.instances);
-  SceneLoadOptions load;
-  load.up = s.up == "y" ? UpAxis::kY : UpAxis::kZ;
-  load.scale = float(s.scale);
+  SceneLoadOptions load = SceneLoad(s.frame);
   load.instance_table = s.instances;
   Result<World> world = LoadWorld(s.scene, load);
   if (!world.ok()) return world.status().WithContext(s.scene);

@@ -25,8 +25,7 @@ struct SimRenderOptions {
   std::string scene;
   std::string trajectory;
   std::string out_dir;
-  std::string up = "z";
-  double scale = 1.0;
+  SceneFrameOptions frame;
   std::string size = "640x480";
   double fx = 525.0, fy = 0.0, cx = -1.0, cy = -1.0;  // fy 0: fx; cx, cy < 0: image centre
   std::string noise = "on";
@@ -56,8 +55,6 @@ int RunSimRender(const SimRenderOptions& o) {
   int width = 0, height = 0;
   if (!ParseSize(o.size, width, height))
     return Fail("--size wants WIDTHxHEIGHT (e.g. 640x480), got '" + o.size + "'", kExitUsage);
-  if (o.up != "z" && o.up != "y" && o.up != "Z" && o.up != "Y")
-    return Fail("--up must be z or y, got '" + o.up + "'", kExitUsage);
   if (o.noise != "on" && o.noise != "off")
     return Fail("--noise must be on or off, got '" + o.noise + "'", kExitUsage);
   std::error_code ec;
@@ -91,10 +88,7 @@ int RunSimRender(const SimRenderOptions& o) {
 
   ThreadLimit limit(o.threads);
   const Stopwatch clock;
-  SceneLoadOptions load;
-  load.scale = float(o.scale);
-  load.up = (o.up == "y" || o.up == "Y") ? UpAxis::kY : UpAxis::kZ;
-  Result<World> world = LoadWorld(o.scene, load);
+  Result<World> world = LoadWorld(o.scene, SceneLoad(o.frame));
   if (!world.ok()) {
     const bool usage = world.status().code() == StatusCode::kInvalidArgument;
     return Fail(MessageNaming(world.status(), o.scene), usage ? kExitUsage : kExitFailure);
@@ -164,10 +158,7 @@ Command AddSimRenderCommand(CLI::App& sim) {
       ->required();
   sub->add_option("--out,-o", o->out_dir, "Output folder (created if its parent exists)")
       ->required();
-  sub->add_option("--up", o->up, "Scene up axis: z or y")->capture_default_str();
-  sub->add_option("--scale", o->scale, "Scene scale to metres")
-      ->check(Positive())
-      ->capture_default_str();
+  AddSceneFrameOptions(sub, o->frame);
   sub->add_option("--size", o->size, "Image size WIDTHxHEIGHT")->capture_default_str();
   sub->add_option("--fx", o->fx, "Focal length, pixels")->check(Positive())->capture_default_str();
   sub->add_option("--fy", o->fy, "Focal length y, pixels (default: fx)");

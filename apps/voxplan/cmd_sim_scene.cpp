@@ -22,8 +22,7 @@ struct SimSceneOptions {
   std::string scene;
   std::string size = "M";
   uint64_t seed = 0;
-  std::string up = "z";
-  double scale = 1.0;
+  SceneFrameOptions frame;
   std::string out_dir;
   std::string name = "world";
   std::string furniture_index;
@@ -56,8 +55,6 @@ int RunSimScene(const SimSceneOptions& o) {
     return Fail("--generate knows only 'apartment', got '" + o.generate + "'", kExitUsage);
   Result<ApartmentSize> size = ParseApartmentSize(o.size);
   if (!size.ok()) return Fail(size.status().message(), kExitUsage);
-  if (o.up != "z" && o.up != "y" && o.up != "Z" && o.up != "Y")
-    return Fail("--up must be z or y, got '" + o.up + "'", kExitUsage);
   if (o.no_ply && o.no_glb && o.scene.empty())
     return Fail("--no-ply with --no-glb would write no mesh", kExitUsage);
   std::error_code ec;
@@ -91,9 +88,7 @@ int RunSimScene(const SimSceneOptions& o) {
     world = GenerateApartment(params);
     if (!world.ok()) return Fail(world.status().message());
   } else {
-    SceneLoadOptions load;
-    load.scale = float(o.scale);
-    load.up = (o.up == "y" || o.up == "Y") ? UpAxis::kY : UpAxis::kZ;
+    SceneLoadOptions load = SceneLoad(o.frame);
     load.furniture_index = o.furniture_index;
     world = LoadWorld(o.scene, load);
     if (!world.ok()) {
@@ -135,8 +130,8 @@ int RunSimScene(const SimSceneOptions& o) {
     j["furniture_index"] = furniture_index;
   } else {
     j["scene"] = o.scene;
-    j["scale"] = o.scale;
-    j["up"] = o.up;
+    j["scale"] = o.frame.scale;
+    j["up"] = o.frame.up;
   }
   j["out"] = o.out_dir;
   j["area_m2"] = RoundTo(inside_cells * cell_area, 2);  // floor plan: everything not outside
@@ -174,10 +169,7 @@ Command AddSimSceneCommand(CLI::App& sim) {
       ->capture_default_str();
   sub->add_option("--seed", o->seed, "Generator seed (same seed, same files)")
       ->capture_default_str();
-  sub->add_option("--up", o->up, "Scene up axis: z or y")->capture_default_str();
-  sub->add_option("--scale", o->scale, "Scene scale to metres")
-      ->check(Positive())
-      ->capture_default_str();
+  AddSceneFrameOptions(sub, o->frame);
   sub->add_option("--out,-o", o->out_dir, "Output folder (created if its parent exists)")
       ->required();
   sub->add_option("--name", o->name, "File name stem of the outputs")->capture_default_str();

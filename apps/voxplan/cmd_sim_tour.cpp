@@ -21,8 +21,7 @@ namespace fs = std::filesystem;
 struct SimTourOptions {
   std::string scene;
   std::string out;
-  std::string up = "z";
-  double scale = 1.0;
+  SceneFrameOptions frame;
   std::string mode = "explorer";
   double radius = 0.2;
   double camera_height = 1.2;
@@ -36,8 +35,6 @@ struct SimTourOptions {
 };
 
 int RunSimTour(const SimTourOptions& o) {
-  if (o.up != "z" && o.up != "y" && o.up != "Z" && o.up != "Y")
-    return Fail("--up must be z or y, got '" + o.up + "'", kExitUsage);
   if (o.mode != "explorer" && o.mode != "reconstructor")
     return Fail("--mode must be explorer or reconstructor, got '" + o.mode + "'", kExitUsage);
   std::error_code ec;
@@ -64,10 +61,7 @@ int RunSimTour(const SimTourOptions& o) {
 
   ThreadLimit limit(o.threads);
   const Stopwatch clock;
-  SceneLoadOptions load;
-  load.scale = float(o.scale);
-  load.up = (o.up == "y" || o.up == "Y") ? UpAxis::kY : UpAxis::kZ;
-  Result<World> world = LoadWorld(o.scene, load);
+  Result<World> world = LoadWorld(o.scene, SceneLoad(o.frame));
   if (!world.ok()) {
     const bool usage = world.status().code() == StatusCode::kInvalidArgument;
     return Fail(MessageNaming(world.status(), o.scene), usage ? kExitUsage : kExitFailure);
@@ -120,10 +114,7 @@ Command AddSimTourCommand(CLI::App& sim) {
       ->required();
   sub->add_option("--out,-o", o->out, "Trajectory file to write (TUM, camera-to-world)")
       ->required();
-  sub->add_option("--up", o->up, "Scene up axis: z or y")->capture_default_str();
-  sub->add_option("--scale", o->scale, "Scene scale to metres")
-      ->check(Positive())
-      ->capture_default_str();
+  AddSceneFrameOptions(sub, o->frame);
   sub->add_option("--mode", o->mode, "Robot mode: explorer or reconstructor (speed, field of view)")
       ->capture_default_str();
   sub->add_option("--radius", o->radius, "Robot footprint radius, metres")
