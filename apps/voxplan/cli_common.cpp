@@ -35,6 +35,62 @@ SceneLoadOptions SceneLoad(const SceneFrameOptions& frame) {
   return load;
 }
 
+void AddDatasetInputOptions(CLI::App* sub, DatasetInput& in, bool with_start) {
+  sub->add_option("dataset", in.dataset, "Dataset folder")->required();
+  sub->add_option("--format", in.format, "Dataset format")
+      ->check(CLI::IsMember({"auto", "tum", "icl", "redwood", "7scenes", "3dmatch", "replica"}))
+      ->capture_default_str();
+  sub->add_option("--min-depth", in.min_depth_m, "Ignore depth below this (m)")
+      ->check(NonNegative())
+      ->capture_default_str();
+  sub->add_option("--max-depth", in.max_depth_m, "Ignore depth beyond this (m)")
+      ->check(Positive())
+      ->capture_default_str();
+  sub->add_option("--frames", in.frames, "Frames to use (0: all)")
+      ->check(NonNegative())
+      ->capture_default_str();
+  if (with_start) {
+    sub->add_option("--start", in.start, "First frame (0-based)")
+        ->check(NonNegative())
+        ->capture_default_str();
+  }
+  sub->add_option("--stride", in.stride, "Use every K-th frame")
+      ->check(CLI::Range(int64_t(1), int64_t(1) << 30))
+      ->capture_default_str();
+}
+
+int OpenDatasetInput(const DatasetInput& in, DatasetOptions options, OpenedDataset* out) {
+  if (in.max_depth_m <= in.min_depth_m) {
+    return Fail("--max-depth must be greater than --min-depth", kExitUsage);
+  }
+  Result<DatasetFormat> format = ParseDatasetFormat(in.format);
+  if (!format.ok()) return Fail(format.status().message(), kExitUsage);
+  options.format = *format;
+  std::error_code ec;
+  if (!std::filesystem::exists(in.dataset, ec)) {
+    return Fail("dataset folder not found: " + in.dataset);
+  }
+  if (!std::filesystem::is_directory(in.dataset, ec)) {
+    return Fail("dataset is not a folder: " + in.dataset);
+  }
+  Result<std::unique_ptr<Dataset>> opened = OpenDataset(in.dataset, options);
+  if (!opened.ok()) return Fail(MessageNaming(opened.status(), in.dataset));
+  const DatasetInfo& info = (*opened)->info();
+  for (const std::string& w : info.warnings) Warn(w);
+  out->indices.clear();
+  for (size_t i = size_t(in.start); i < info.num_frames; i += size_t(in.stride)) {
+    if (in.frames > 0 && out->indices.size() == size_t(in.frames)) break;
+    out->indices.push_back(i);
+  }
+  if (out->indices.empty()) {
+    return Fail("no frames selected: the dataset has " + std::to_string(info.num_frames) +
+                    " frames" + (in.start > 0 ? " and --start is " + std::to_string(in.start) : ""),
+                kExitUsage);
+  }
+  out->dataset = std::move(*opened);
+  return kExitOk;
+}
+
 int RunParsed(const std::vector<Command>& commands) {
   for (const Command& command : commands) {
     if (command.app->parsed()) return command.run();

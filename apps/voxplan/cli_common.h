@@ -5,6 +5,7 @@
 #include <chrono>
 #include <cstddef>
 #include <functional>
+#include <memory>
 #include <nlohmann/json.hpp>
 #include <string>
 #include <vector>
@@ -13,6 +14,7 @@
 #include "core/mesh.h"
 #include "core/status.h"
 #include "core/volume.h"
+#include "io/dataset.h"
 #include "sim/scene_loader.h"
 
 namespace voxplan::cli {
@@ -68,6 +70,28 @@ struct SceneFrameOptions {
 void AddSceneFrameOptions(CLI::App* sub, SceneFrameOptions& frame);
 // The load options they ask for (the rest at their defaults).
 SceneLoadOptions SceneLoad(const SceneFrameOptions& frame);
+
+// The dataset a command reads and which of its frames: the positional folder, --format,
+// --min-depth, --max-depth, --frames, --stride (and --start where asked for).
+struct DatasetInput {
+  std::string dataset;
+  std::string format = "auto";
+  double min_depth_m = 0.1;
+  double max_depth_m = 3.0;
+  int64_t frames = 0;  // 0: all; signed so CLI11 refuses negative values instead of wrapping
+  int64_t start = 0;
+  int64_t stride = 1;
+};
+void AddDatasetInputOptions(CLI::App* sub, DatasetInput& in, bool with_start = false);
+
+struct OpenedDataset {
+  std::unique_ptr<Dataset> dataset;
+  std::vector<size_t> indices;  // the selected frames: start, start + stride, ... (at most frames)
+};
+// Refuses a bad depth range, format or folder, opens the dataset (its warnings to stderr) and
+// selects the frames. Returns kExitOk and fills *out, or the exit code after printing why.
+// `options` carries any intrinsics or depth-scale override; its format is set from `in`.
+int OpenDatasetInput(const DatasetInput& in, DatasetOptions options, OpenedDataset* out);
 
 // "fx,fy,cx,cy" -> camera with width/height 0 (the dataset's images give the size).
 Result<PinholeCamera> ParseIntrinsics(const std::string& text);

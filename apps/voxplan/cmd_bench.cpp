@@ -51,14 +51,9 @@ constexpr const char* kSetupHint =
     "install Open3D for /usr/bin/python3 with scripts/setup-deps --bench";
 
 struct BenchOptions {
-  std::string dataset;
-  std::string format = "auto";
+  DatasetInput in;
   double voxel_size_m = 0.01;
   double trunc_m = 0.04;
-  double min_depth_m = 0.1;
-  double max_depth_m = 3.0;
-  int64_t frames = 0;  // 0: all
-  int64_t stride = 1;
   std::string threads;  // "1,2"; empty: 1 and all hardware threads
   int repeat = 3;
   std::string kernel = "auto";
@@ -320,38 +315,26 @@ int RunBench(const BenchOptions& o, BenchMode mode) {
   Result<std::vector<int>> thread_list = ParseThreadList(o.threads);
   if (!thread_list.ok()) return Fail(thread_list.status().message(), kExitUsage);
   if (o.trunc_m < o.voxel_size_m) return Fail("--trunc must be at least --voxel-size", kExitUsage);
-  if (o.max_depth_m <= o.min_depth_m) {
+  if (o.in.max_depth_m <= o.in.min_depth_m) {
     return Fail("--max-depth must be greater than --min-depth", kExitUsage);
   }
-  DatasetOptions dataset_options;
-  Result<DatasetFormat> format = ParseDatasetFormat(o.format);
-  if (!format.ok()) return Fail(format.status().message(), kExitUsage);
-  dataset_options.format = *format;
-  std::error_code ec;
-  if (!fs::is_directory(o.dataset, ec)) return Fail("dataset folder not found: " + o.dataset);
   if (o.vs_open3d) {
     if (Status s = CheckOpen3d(); !s.ok()) return Fail("--vs-open3d: " + s.message());
   }
 
-  Result<std::unique_ptr<Dataset>> opened = OpenDataset(o.dataset, dataset_options);
-  if (!opened.ok()) return Fail(MessageNaming(opened.status(), o.dataset));
-  const Dataset& dataset = **opened;
+  OpenedDataset opened;
+  if (int code = OpenDatasetInput(o.in, {}, &opened); code != kExitOk) return code;
+  const Dataset& dataset = *opened.dataset;
   const DatasetInfo& info = dataset.info();
-  for (const std::string& w : info.warnings) Warn(w);
-  std::vector<size_t> indices;
-  for (size_t i = 0; i < info.num_frames; i += size_t(o.stride)) {
-    if (o.frames > 0 && indices.size() == size_t(o.frames)) break;
-    indices.push_back(i);
-  }
-  if (indices.empty()) return Fail("the dataset has no frames: " + o.dataset);
+  const std::vector<size_t>& indices = opened.indices;
 
   IntegrateParams params;
-  params.min_depth_m = float(o.min_depth_m);
-  params.max_depth_m = float(o.max_depth_m);
+  params.min_depth_m = float(o.in.min_depth_m);
+  params.max_depth_m = float(o.in.max_depth_m);
   params.kernel = kKernels.at(o.kernel);
   const VolumeParams volume_params{float(o.voxel_size_m), float(o.trunc_m)};
   RaycastParams raycast_params;
-  raycast_params.max_depth_m = float(o.max_depth_m);
+  raycast_params.max_depth_m = float(o.in.max_depth_m);
   const char* kernel_name = KernelName(ResolveKernel(params.kernel));
 
   std::cerr << "bench " << ModeName(mode) << ": " << info.root << " ("
@@ -445,7 +428,7 @@ int RunBench(const BenchOptions& o, BenchMode mode) {
         }
         if (integrate_ms.empty()) {
           std::cerr << "\n";
-          return Fail("no frame was integrated (all skipped): " + o.dataset);
+          return Fail("no frame was integrated (all skipped): " + o.in.dataset);
         }
         const TimingSummary t = Summarize(integrate_ms);
         row.integrate_repeat_medians.push_back(t.median);
@@ -472,7 +455,7 @@ int RunBench(const BenchOptions& o, BenchMode mode) {
         std::cerr << "\n";
         return Fail(s.message());
       }
-      if (records.empty()) return Fail("no frame was integrated (all skipped): " + o.dataset);
+      if (records.empty()) return Fail("no frame was integrated (all skipped): " + o.in.dataset);
       record_map(*volume, row);
       if (mode == BenchMode::kRaycast) {
         time_raycasts(*volume, std::max(o.repeat, kRaycastRounds), row);
@@ -501,8 +484,8 @@ int RunBench(const BenchOptions& o, BenchMode mode) {
     }
     // The layout of `fuse --frame-list`, plus a VBG capacity sized from voxplan's map: VBG
     // allocates and touches all of it up front, so a guess would decide its RSS.
-    json list = FrameList(info.camera, info.depth_scale, o.voxel_size_m, o.trunc_m, o.min_depth_m,
-                          o.max_depth_m, frames);
+    json list = FrameList(info.camera, info.depth_scale, o.voxel_size_m, o.trunc_m,
+                          o.in.min_depth_m, o.in.max_depth_m, frames);
     list["vbg_block_count"] = std::max<size_t>(1024, rows.back().blocks * 5 / 4);
     TempFrameList list_file;
     if (Status s = list_file.Write(list); !s.ok()) return Fail(s.message());
@@ -578,17 +561,17 @@ int RunBench(const BenchOptions& o, BenchMode mode) {
 
   json j;
   j["command"] = std::string("bench ") + ModeName(mode);
-  j["dataset"] = o.dataset;
+  j["dataset"] = o.in.dataset;
   j["format"] = DatasetFormatName(info.format);
   j["frames"] = records.size();
   j["frames_selected"] = indices.size();
   j["frames_skipped_no_pose"] = skipped_no_pose;
   j["frames_skipped_no_depth"] = skipped_no_depth;
-  j["stride"] = o.stride;
+  j["stride"] = o.in.stride;
   j["voxel_size_m"] = o.voxel_size_m;
   j["trunc_m"] = o.trunc_m;
-  j["min_depth_m"] = o.min_depth_m;
-  j["max_depth_m"] = o.max_depth_m;
+  j["min_depth_m"] = o.in.min_depth_m;
+  j["max_depth_m"] = o.in.max_depth_m;
   j["repeat"] = o.repeat;
   j["threads"] = *thread_list;
   j["kernel"] = kernel_name;
@@ -683,27 +666,12 @@ int RunBench(const BenchOptions& o, BenchMode mode) {
 }
 
 void AddBenchOptions(CLI::App* sub, BenchOptions& o) {
-  sub->add_option("dataset", o.dataset, "Dataset folder")->required();
-  sub->add_option("--format", o.format, "Dataset format")
-      ->check(CLI::IsMember({"auto", "tum", "icl", "redwood", "7scenes", "3dmatch", "replica"}))
-      ->capture_default_str();
+  AddDatasetInputOptions(sub, o.in);
   sub->add_option("--voxel-size", o.voxel_size_m, "Voxel size in metres")
       ->check(Positive())
       ->capture_default_str();
   sub->add_option("--trunc", o.trunc_m, "Truncation distance in metres")
       ->check(Positive())
-      ->capture_default_str();
-  sub->add_option("--min-depth", o.min_depth_m, "Ignore depth below this (m)")
-      ->check(NonNegative())
-      ->capture_default_str();
-  sub->add_option("--max-depth", o.max_depth_m, "Ignore depth beyond this (m)")
-      ->check(Positive())
-      ->capture_default_str();
-  sub->add_option("--frames", o.frames, "Frames to use (0: all)")
-      ->check(NonNegative())
-      ->capture_default_str();
-  sub->add_option("--stride", o.stride, "Use every K-th frame")
-      ->check(CLI::Range(int64_t(1), int64_t(1) << 30))
       ->capture_default_str();
   sub->add_option("--threads", o.threads,
                   "Comma-separated thread counts, one row each (default: 1 and all)");

@@ -25,14 +25,9 @@ namespace fs = std::filesystem;
 using nlohmann::json;
 
 struct MapsOptions {
-  std::string dataset;
-  std::string format = "auto";
+  DatasetInput in;  // 30 frames unless told otherwise (set where the options are added)
   double resolution_m = 0.05;
   double trunc_vox = 3.0;
-  double min_depth_m = 0.1;
-  double max_depth_m = 3.0;
-  int64_t frames = 30;
-  int64_t stride = 1;
   int threads = 2;
   bool vs_octomap = false;
   std::string json_path;
@@ -60,25 +55,17 @@ octomap::Pointcloud WorldCloud(const LoadedFrame& f, const PinholeCamera& cam, f
 }
 
 int RunBenchMaps(const MapsOptions& o) {
-  DatasetOptions dataset_options;
-  Result<DatasetFormat> format = ParseDatasetFormat(o.format);
-  if (!format.ok()) return Fail(format.status().message(), kExitUsage);
-  dataset_options.format = *format;
-  std::error_code ec;
-  if (!fs::is_directory(o.dataset, ec)) return Fail("dataset folder not found: " + o.dataset);
-  Result<std::unique_ptr<Dataset>> opened = OpenDataset(o.dataset, dataset_options);
-  if (!opened.ok()) return Fail(MessageNaming(opened.status(), o.dataset));
-  const Dataset& dataset = **opened;
+  OpenedDataset opened;
+  if (int code = OpenDatasetInput(o.in, {}, &opened); code != kExitOk) return code;
+  const Dataset& dataset = *opened.dataset;
   const DatasetInfo& info = dataset.info();
-  for (const std::string& w : info.warnings) Warn(w);
 
   // Decode once, untimed; frames without a pose or without depth are skipped.
   std::vector<LoadedFrame> frames;
   size_t skipped = 0;
-  for (size_t i = 0; i < info.num_frames; i += size_t(o.stride)) {
-    if (o.frames > 0 && frames.size() == size_t(o.frames)) break;
+  for (size_t i : opened.indices) {
     Result<Frame> frame = dataset.Load(i);
-    if (!frame.ok()) return Fail(MessageNaming(frame.status(), o.dataset));
+    if (!frame.ok()) return Fail(MessageNaming(frame.status(), o.in.dataset));
     const bool has_depth = std::any_of(frame->depth.data.begin(), frame->depth.data.end(),
                                        [](float z) { return z > 0.f; });
     if (!frame->T_W_C || !has_depth) {
@@ -87,19 +74,19 @@ int RunBenchMaps(const MapsOptions& o) {
     }
     frames.push_back({std::move(frame->depth), frame->T_W_C->cast<float>()});
   }
-  if (frames.empty()) return Fail("no frame with depth and a pose in " + o.dataset);
+  if (frames.empty()) return Fail("no frame with depth and a pose in " + o.in.dataset);
 
   const float resolution = float(o.resolution_m);
   const VolumeParams volume_params{resolution, float(o.trunc_vox * o.resolution_m)};
   IntegrateParams params;
-  params.min_depth_m = float(o.min_depth_m);
-  params.max_depth_m = float(o.max_depth_m);
+  params.min_depth_m = float(o.in.min_depth_m);
+  params.max_depth_m = float(o.in.max_depth_m);
   params.integrate_color = false;  // a planning map needs no colour
   std::cerr << "bench maps: " << info.root << " (" << DatasetFormatName(info.format) << "), "
             << frames.size() << " frames (" << skipped << " skipped), " << info.camera.width << "x"
             << info.camera.height << ", resolution " << o.resolution_m << " m, trunc "
-            << volume_params.trunc_m << " m, depth [" << o.min_depth_m << ", " << o.max_depth_m
-            << "] m, " << o.threads << " threads" << std::endl;
+            << volume_params.trunc_m << " m, depth [" << o.in.min_depth_m << ", "
+            << o.in.max_depth_m << "] m, " << o.threads << " threads" << std::endl;
 
   TsdfVolume volume(volume_params);
   PlanningMap map(volume);
@@ -132,8 +119,8 @@ int RunBenchMaps(const MapsOptions& o) {
   j["format"] = DatasetFormatName(info.format);
   j["resolution"] = o.resolution_m;
   j["trunc_m"] = FloatValue(volume_params.trunc_m);
-  j["min_depth_m"] = o.min_depth_m;
-  j["max_depth_m"] = o.max_depth_m;
+  j["min_depth_m"] = o.in.min_depth_m;
+  j["max_depth_m"] = o.in.max_depth_m;
   j["frames"] = frames.size();
   j["threads"] = o.threads;
   j["width"] = info.camera.width;
@@ -225,27 +212,13 @@ Command AddBenchMapsCommand(CLI::App& bench) {
   auto o = std::make_shared<MapsOptions>();
   CLI::App* sub = bench.add_subcommand(
       "maps", "Time the planning-map update per frame, optionally beside OctoMap");
-  sub->add_option("dataset", o->dataset, "Dataset folder")->required();
-  sub->add_option("--format", o->format, "Dataset format")
-      ->check(CLI::IsMember({"auto", "tum", "icl", "redwood", "7scenes", "3dmatch", "replica"}))
-      ->capture_default_str();
+  o->in.frames = 30;
+  AddDatasetInputOptions(sub, o->in);
   sub->add_option("--resolution", o->resolution_m, "Planning voxel size in metres")
       ->check(CLI::Range(0.005, 1.0))
       ->capture_default_str();
   sub->add_option("--trunc-vox", o->trunc_vox, "Truncation distance in voxels")
       ->check(CLI::Range(1.0, 64.0))
-      ->capture_default_str();
-  sub->add_option("--min-depth", o->min_depth_m, "Ignore depth below this (m)")
-      ->check(NonNegative())
-      ->capture_default_str();
-  sub->add_option("--max-depth", o->max_depth_m, "Ignore depth beyond this (m); OctoMap too")
-      ->check(Positive())
-      ->capture_default_str();
-  sub->add_option("--frames", o->frames, "Frames to use (0: all)")
-      ->check(NonNegative())
-      ->capture_default_str();
-  sub->add_option("--stride", o->stride, "Use every K-th frame")
-      ->check(CLI::Range(int64_t(1), int64_t(1) << 30))
       ->capture_default_str();
   sub->add_option("--threads", o->threads, "Threads for the planning map")
       ->check(CLI::Range(1, 4096))
@@ -255,11 +228,7 @@ Command AddBenchMapsCommand(CLI::App& bench) {
   sub->add_option("--json", o->json_path, "Write the result JSON")->check(OutputFileValidator());
   sub->add_option("--export-bt", o->bt_path, "Write the final occupancy as an OctoMap .bt")
       ->check(OutputFileValidator());
-  return {sub, [o] {
-            if (o->min_depth_m >= o->max_depth_m)
-              return Fail("--min-depth must be below --max-depth", kExitUsage);
-            return RunBenchMaps(*o);
-          }};
+  return {sub, [o] { return RunBenchMaps(*o); }};
 }
 
 }  // namespace voxplan::cli

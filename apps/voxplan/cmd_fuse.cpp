@@ -30,16 +30,9 @@ const std::map<std::string, Kernel> kKernels = {
     {"auto", Kernel::kAuto}, {"scalar", Kernel::kScalar}, {"simd", Kernel::kSimd}};
 
 struct FuseOptions {
-  std::string dataset;
-  std::string format = "auto";
+  DatasetInput in;
   double voxel_size_m = 0.01;
   double trunc_m = 0.04;
-  double min_depth_m = 0.1;
-  double max_depth_m = 3.0;
-  // Signed so CLI11 refuses negative values instead of wrapping them.
-  int64_t frames = 0;  // 0: all
-  int64_t start = 0;
-  int64_t stride = 1;
   int threads = 0;
   std::string intrinsics;
   double depth_scale = 0.0;
@@ -71,13 +64,7 @@ int RunFuse(const FuseOptions& o) {
             << ")";
     return Fail(message.str(), kExitUsage);
   }
-  if (o.max_depth_m <= o.min_depth_m) {
-    return Fail("--max-depth must be greater than --min-depth", kExitUsage);
-  }
   DatasetOptions dataset_options;
-  Result<DatasetFormat> format = ParseDatasetFormat(o.format);
-  if (!format.ok()) return Fail(format.status().message(), kExitUsage);
-  dataset_options.format = *format;
   if (!o.intrinsics.empty()) {
     Result<PinholeCamera> camera = ParseIntrinsics(o.intrinsics);
     if (!camera.ok()) return Fail(camera.status().message(), kExitUsage);
@@ -85,31 +72,16 @@ int RunFuse(const FuseOptions& o) {
   }
   if (o.depth_scale > 0.0) dataset_options.depth_scale = o.depth_scale;
 
-  std::error_code ec;
-  if (!fs::exists(o.dataset, ec)) return Fail("dataset folder not found: " + o.dataset);
-  if (!fs::is_directory(o.dataset, ec)) return Fail("dataset is not a folder: " + o.dataset);
-
   ThreadLimit thread_limit(o.threads);
-  Result<std::unique_ptr<Dataset>> opened = OpenDataset(o.dataset, dataset_options);
-  if (!opened.ok()) return Fail(MessageNaming(opened.status(), o.dataset));
-  const Dataset& dataset = **opened;
+  OpenedDataset opened;
+  if (int code = OpenDatasetInput(o.in, dataset_options, &opened); code != kExitOk) return code;
+  const Dataset& dataset = *opened.dataset;
   const DatasetInfo& info = dataset.info();
-  for (const std::string& w : info.warnings) Warn(w);
-
-  std::vector<size_t> indices;
-  for (size_t i = size_t(o.start); i < info.num_frames; i += size_t(o.stride)) {
-    if (o.frames > 0 && indices.size() == size_t(o.frames)) break;
-    indices.push_back(i);
-  }
-  if (indices.empty()) {
-    return Fail("no frames selected: the dataset has " + std::to_string(info.num_frames) +
-                    " frames and --start is " + std::to_string(o.start),
-                kExitUsage);
-  }
+  const std::vector<size_t>& indices = opened.indices;
 
   IntegrateParams params;
-  params.min_depth_m = float(o.min_depth_m);
-  params.max_depth_m = float(o.max_depth_m);
+  params.min_depth_m = float(o.in.min_depth_m);
+  params.max_depth_m = float(o.in.max_depth_m);
   params.max_weight = float(o.max_weight);
   params.weighting = kWeightings.at(o.weighting);
   params.kernel = kKernels.at(o.kernel);
@@ -130,8 +102,8 @@ int RunFuse(const FuseOptions& o) {
   if (o.track) {
     TrackingParams tracking;
     tracking.photometric_weight = float(o.photometric_weight);
-    tracking.raycast.max_depth_m = float(o.max_depth_m);
-    tracking.raycast.min_depth_m = float(o.min_depth_m);
+    tracking.raycast.max_depth_m = float(o.in.max_depth_m);
+    tracking.raycast.min_depth_m = float(o.in.min_depth_m);
     tracker.emplace(info.camera, tracking);
   }
   Progress progress("fuse", indices.size());
@@ -214,7 +186,7 @@ int RunFuse(const FuseOptions& o) {
   }
   if (frame_ms.empty()) {
     return Fail("no frame was integrated (" + std::to_string(indices.size()) +
-                " selected, all skipped): " + o.dataset);
+                " selected, all skipped): " + o.in.dataset);
   }
 
   Mesh mesh;
@@ -240,7 +212,7 @@ int RunFuse(const FuseOptions& o) {
     // Exactly the frames integrated, with the parameters, for reference runs of other
     // pipelines (bench/open3d_fusion.py) on identical input.
     const nlohmann::json list = FrameList(info.camera, info.depth_scale, o.voxel_size_m, o.trunc_m,
-                                          o.min_depth_m, o.max_depth_m, frame_list);
+                                          o.in.min_depth_m, o.in.max_depth_m, frame_list);
     if (Status s = WriteJsonFile(list, o.frame_list_path); !s.ok())
       return Fail(MessageNaming(s, o.frame_list_path));
   }
@@ -250,7 +222,7 @@ int RunFuse(const FuseOptions& o) {
   const size_t integrated = frame_ms.size();
   nlohmann::json j;
   j["command"] = "fuse";
-  j["dataset"] = o.dataset;
+  j["dataset"] = o.in.dataset;
   j["format"] = DatasetFormatName(info.format);
   j["frames"] = integrated;
   j["frames_selected"] = indices.size();
@@ -263,8 +235,8 @@ int RunFuse(const FuseOptions& o) {
   j["frames_skipped_no_depth"] = skipped_empty;
   j["voxel_size_m"] = o.voxel_size_m;
   j["trunc_m"] = o.trunc_m;
-  j["min_depth_m"] = o.min_depth_m;
-  j["max_depth_m"] = o.max_depth_m;
+  j["min_depth_m"] = o.in.min_depth_m;
+  j["max_depth_m"] = o.in.max_depth_m;
   j["max_weight"] = o.max_weight;
   j["weighting"] = o.weighting;
   j["threads"] = MaxThreads();
@@ -315,30 +287,12 @@ int RunFuse(const FuseOptions& o) {
 Command AddFuseCommand(CLI::App& app) {
   auto o = std::make_shared<FuseOptions>();
   CLI::App* sub = app.add_subcommand("fuse", "Integrate an RGB-D dataset into a TSDF map");
-  sub->add_option("dataset", o->dataset, "Dataset folder")->required();
-  sub->add_option("--format", o->format, "Dataset format")
-      ->check(CLI::IsMember({"auto", "tum", "icl", "redwood", "7scenes", "3dmatch", "replica"}))
-      ->capture_default_str();
+  AddDatasetInputOptions(sub, o->in, /*with_start=*/true);
   sub->add_option("--voxel-size", o->voxel_size_m, "Voxel size in metres")
       ->check(Positive())
       ->capture_default_str();
   sub->add_option("--trunc", o->trunc_m, "Truncation distance in metres")
       ->check(Positive())
-      ->capture_default_str();
-  sub->add_option("--min-depth", o->min_depth_m, "Ignore depth below this (m)")
-      ->check(NonNegative())
-      ->capture_default_str();
-  sub->add_option("--max-depth", o->max_depth_m, "Ignore depth beyond this (m)")
-      ->check(Positive())
-      ->capture_default_str();
-  sub->add_option("--frames", o->frames, "Frames to process (0: all)")
-      ->check(NonNegative())
-      ->capture_default_str();
-  sub->add_option("--start", o->start, "First frame (0-based)")
-      ->check(NonNegative())
-      ->capture_default_str();
-  sub->add_option("--stride", o->stride, "Use every K-th frame")
-      ->check(CLI::Range(int64_t(1), int64_t(1) << 30))
       ->capture_default_str();
   sub->add_option("--threads", o->threads, "Worker threads (0: all hardware threads)")
       ->check(NonNegative())
