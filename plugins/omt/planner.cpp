@@ -31,34 +31,22 @@ void ParallelFor(int n, int threads, const std::function<void(int)>& fn) {
 
 }  // namespace
 
-Status PlanOmt(const OccupancyRaster& raster, const ClearanceRaster* clearance_in,
-               const std::vector<RobotState>& robots, const PlannerOptions& options,
-               PlanResult* result, const GeodesicProvider* provider) {
-  *result = PlanResult{};
+ViewSet ExtractAccessibleViews(const OccupancyRaster& raster, const ClearanceRaster& clearance,
+                               const std::vector<RobotState>& robots,
+                               const PlannerOptions& options) {
   const RasterGeometry& g = raster.geometry;
-  if (g.NumCells() <= 0 || raster.cells.size() != static_cast<std::size_t>(g.NumCells()))
-    return Status::Error(Status::Code::kInvalidInput, "raster size does not match its geometry");
-  if (!raster.tsdf_weight.empty() && raster.tsdf_weight.size() != raster.cells.size())
-    return Status::Error(Status::Code::kInvalidInput, "tsdf_weight size does not match");
-  if (robots.empty()) return Status::Error(Status::Code::kInvalidInput, "no robots");
-  if (clearance_in && clearance_in->clearance_m.size() != raster.cells.size())
-    return Status::Error(Status::Code::kInvalidInput, "clearance size does not match");
-  ClearanceRaster computed;
-  if (!clearance_in) computed = ComputeClearance(raster, /*unknown_is_obstacle=*/true);
-  const ClearanceRaster& clearance = clearance_in ? *clearance_in : computed;
   const int R = static_cast<int>(robots.size());
-  result->robots.resize(static_cast<std::size_t>(R));
-
+  ViewSet out;
   // Geodesic grid, robots joined to it, the part of it they can reach.
-  const GeodesicGrid grid =
-      BuildGeodesicGrid(clearance, options.geodesic_cell_m, options.robot_radius_m);
-  std::vector<Anchor> anchors;
+  out.grid = BuildGeodesicGrid(clearance, options.geodesic_cell_m, options.robot_radius_m);
+  const GeodesicGrid& grid = out.grid;
   std::vector<int> sources;
   for (const RobotState& r : robots) {
-    anchors.push_back(AnchorPoint(grid, clearance, r.position_m, options.robot_radius_m));
-    sources.push_back(anchors.back().node);
+    out.anchors.push_back(AnchorPoint(grid, clearance, r.position_m, options.robot_radius_m));
+    sources.push_back(out.anchors.back().node);
   }
-  const std::vector<std::uint8_t> reachable = ReachableNodes(grid, sources);
+  out.reachable = ReachableNodes(grid, sources);
+  const std::vector<std::uint8_t>& reachable = out.reachable;
   // A fine cell is accessible when a reachable node lies within one grid step; the exact
   // test (a clear anchor segment) follows per view.
   std::vector<std::uint8_t> accessible(static_cast<std::size_t>(g.NumCells()), 0);
@@ -88,9 +76,36 @@ Status PlanOmt(const OccupancyRaster& raster, const ClearanceRaster* clearance_i
   for (const TaskView& v : extracted) {
     Anchor a = AnchorPoint(grid, clearance, v.position_m, options.robot_radius_m);
     if (a.node < 0 || !reachable[static_cast<std::size_t>(a.node)]) continue;
-    result->views.push_back(v);
-    anchors.push_back(a);
+    out.views.push_back(v);
+    out.anchors.push_back(a);
   }
+  return out;
+}
+
+Status PlanOmt(const OccupancyRaster& raster, const ClearanceRaster* clearance_in,
+               const std::vector<RobotState>& robots, const PlannerOptions& options,
+               PlanResult* result, const GeodesicProvider* provider) {
+  *result = PlanResult{};
+  const RasterGeometry& g = raster.geometry;
+  if (g.NumCells() <= 0 || raster.cells.size() != static_cast<std::size_t>(g.NumCells()))
+    return Status::Error(Status::Code::kInvalidInput, "raster size does not match its geometry");
+  if (!raster.tsdf_weight.empty() && raster.tsdf_weight.size() != raster.cells.size())
+    return Status::Error(Status::Code::kInvalidInput, "tsdf_weight size does not match");
+  if (robots.empty()) return Status::Error(Status::Code::kInvalidInput, "no robots");
+  if (clearance_in && clearance_in->clearance_m.size() != raster.cells.size())
+    return Status::Error(Status::Code::kInvalidInput, "clearance size does not match");
+  ClearanceRaster computed;
+  if (!clearance_in) computed = ComputeClearance(raster, /*unknown_is_obstacle=*/true);
+  const ClearanceRaster& clearance = clearance_in ? *clearance_in : computed;
+  const int R = static_cast<int>(robots.size());
+  result->robots.resize(static_cast<std::size_t>(R));
+
+  ViewSet view_set = ExtractAccessibleViews(raster, clearance, robots, options);
+  const GeodesicGrid& grid = view_set.grid;
+  std::vector<Anchor>& anchors = view_set.anchors;
+  result->views = std::move(view_set.views);
+  for (int r = 0; r < R; ++r)
+    result->anchored_robots += anchors[static_cast<std::size_t>(r)].node >= 0;
   result->terminated = ShouldTerminate(result->views, options.importance_threshold);
   if (result->terminated) return Status::Ok();
   const int K = static_cast<int>(result->views.size());

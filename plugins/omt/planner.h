@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "plugins/omt/assignment.h"
+#include "plugins/omt/geodesic.h"
 #include "plugins/omt/smoothing.h"
 #include "plugins/omt/task_views.h"
 #include "plugins/omt/tsp.h"
@@ -50,6 +51,9 @@ struct PlanResult {
   Assignment assignment;
   std::vector<RobotPlan> robots;  // one per input robot; empty plan = no task this pass
   bool terminated = false;        // no accessible view with importance above the threshold
+  // Robots joined to the internal geodesic grid. With none, no view can be accessible and
+  // `terminated` says nothing about the scene (e.g. too little known free space around them).
+  int anchored_robots = 0;
 };
 
 // External geodesics (e.g. the host's distance_matrix / shortest_path queries) to use instead
@@ -63,6 +67,19 @@ struct GeodesicProvider {
                      std::vector<Eigen::Vector2d>* out)>
       shortest_path;
 };
+
+// The accessible task views of one pass (§3.2, at most κR) and the internal geodesic grid they
+// were checked on: PlanOmt's first stage, exposed so the baselines (GRD, SEG of §4) plan over
+// exactly the same views. kappa, robot_radius_m, views and use_task_views apply as in PlanOmt.
+struct ViewSet {
+  GeodesicGrid grid;
+  std::vector<Anchor> anchors;          // one per robot, then one per view
+  std::vector<std::uint8_t> reachable;  // grid nodes some robot reaches
+  std::vector<TaskView> views;          // only views whose anchor is reachable
+};
+ViewSet ExtractAccessibleViews(const OccupancyRaster& raster, const ClearanceRaster& clearance,
+                               const std::vector<RobotState>& robots,
+                               const PlannerOptions& options);
 
 // clearance may be null: it is then computed from the raster (unknown counts as obstacle).
 // Views are still restricted to cells the internal grid reaches from some robot.

@@ -1,106 +1,102 @@
 #include "tests/plugins/fake_world.h"
 
+#include <algorithm>
 #include <cmath>
-#include <limits>
+
+#include "core/geodesic.h"
+#include "core/image.h"
 
 namespace voxplan::test {
 
-FakeWorld::FakeWorld() {
+RasterWorld::RasterWorld(int width, int height, float cell_m) {
   floor_.origin_m = {0.f, 0.f};
-  floor_.cell_size_m = kCell;
-  floor_.width = kWidth;
-  floor_.height = kHeight;
+  floor_.cell_size_m = cell_m;
+  floor_.width = width;
+  floor_.height = height;
   floor_.revision = 7;
-  floor_.cells.assign(size_t(kWidth) * kHeight, FloorCell::kFree);
-  auto set = [&](int x, int y, FloorCell c) { floor_.cells[floor_.Linear(x, y)] = c; };
-  for (int x = 0; x < kWidth; ++x) {
-    set(x, 0, FloorCell::kObstacle);
-    set(x, kHeight - 1, FloorCell::kObstacle);
-  }
-  for (int y = 0; y < kHeight; ++y) {
-    set(0, y, FloorCell::kObstacle);
-    set(kWidth - 1, y, FloorCell::kObstacle);
-    if (y < 5 || y > 7) set(9, y, FloorCell::kObstacle);  // wall with a door at y 5..7
-  }
-  for (int x = 2; x <= 6; ++x) {  // the sealed pocket
-    for (int y = 6; y <= 10; ++y) {
-      if (x == 2 || x == 6 || y == 6 || y == 10) set(x, y, FloorCell::kObstacle);
+  floor_.cells.assign(size_t(width) * size_t(height), FloorCell::kFree);
+  Finish();
+}
+
+void RasterWorld::Fill(int x0, int y0, int x1, int y1, FloorCell cell) {
+  for (int y = std::max(y0, 0); y <= std::min(y1, floor_.height - 1); ++y) {
+    for (int x = std::max(x0, 0); x <= std::min(x1, floor_.width - 1); ++x) {
+      floor_.cells[floor_.Linear(x, y)] = cell;
     }
   }
-  for (int x = 13; x <= 17; ++x) {
-    for (int y = 1; y <= 4; ++y) set(x, y, FloorCell::kUnknown);
-  }
-  // Frontier: free and 8-adjacent to unknown.
+}
+
+void RasterWorld::Walls() {
+  Fill(0, 0, floor_.width - 1, 0, FloorCell::kObstacle);
+  Fill(0, floor_.height - 1, floor_.width - 1, floor_.height - 1, FloorCell::kObstacle);
+  Fill(0, 0, 0, floor_.height - 1, FloorCell::kObstacle);
+  Fill(floor_.width - 1, 0, floor_.width - 1, floor_.height - 1, FloorCell::kObstacle);
+}
+
+void RasterWorld::Finish() {
+  // Frontier: free and 8-adjacent to unknown (re-derived, so earlier marks may go).
   std::vector<FloorCell> cells = floor_.cells;
-  for (int y = 0; y < kHeight; ++y) {
-    for (int x = 0; x < kWidth; ++x) {
-      if (floor_.cells[floor_.Linear(x, y)] != FloorCell::kFree) continue;
+  for (int y = 0; y < floor_.height; ++y) {
+    for (int x = 0; x < floor_.width; ++x) {
+      FloorCell& c = cells[floor_.Linear(x, y)];
+      if (!IsFree(c)) continue;
+      c = FloorCell::kFree;
       for (int dy = -1; dy <= 1; ++dy) {
         for (int dx = -1; dx <= 1; ++dx) {
           if (floor_.Contains(x + dx, y + dy) &&
               floor_.cells[floor_.Linear(x + dx, y + dy)] == FloorCell::kUnknown) {
-            cells[floor_.Linear(x, y)] = FloorCell::kFrontier;
+            c = FloorCell::kFrontier;
           }
         }
       }
     }
   }
   floor_.cells = cells;
-  // Clearance: centre to the nearest obstacle cell centre (brute force; the grid is tiny).
-  floor_.clearance_m.assign(floor_.cells.size(), std::numeric_limits<float>::infinity());
-  for (int y = 0; y < kHeight; ++y) {
-    for (int x = 0; x < kWidth; ++x) {
-      float& c = floor_.clearance_m[floor_.Linear(x, y)];
-      for (int oy = 0; oy < kHeight; ++oy) {
-        for (int ox = 0; ox < kWidth; ++ox) {
-          if (floor_.cells[floor_.Linear(ox, oy)] != FloorCell::kObstacle) continue;
-          c = std::min(c, kCell * std::hypot(float(ox - x), float(oy - y)));
-        }
-      }
-    }
+  // Clearance: exact distance from the cell centre to the nearest obstacle cell centre.
+  Image<uint8_t> sites(floor_.width, floor_.height, 0);
+  for (size_t i = 0; i < cells.size(); ++i) sites.data[i] = cells[i] == FloorCell::kObstacle;
+  const Image<float> d2 = SquaredDistanceTransform(sites);
+  floor_.clearance_m.resize(cells.size());
+  for (size_t i = 0; i < cells.size(); ++i) {
+    floor_.clearance_m[i] = std::sqrt(d2.data[i]) * floor_.cell_size_m;
   }
+}
 
+PlannerRobot& RasterWorld::AddRobot(int ix, int iy, float radius_m) {
   ScanMode explorer, reconstructor;
   explorer.max_speed_mps = 0.6f;
   explorer.max_range_m = 5.f;
   reconstructor.max_speed_mps = 0.2f;
   reconstructor.horizontal_fov_rad = 0.8f;
   reconstructor.max_range_m = 1.5f;
-  for (int i = 0; i < 2; ++i) {
-    PlannerRobot r;
-    r.id = uint32_t(10 + i);
-    r.position_m = i == 0 ? Center(3, 2) : Center(14, 8);
-    r.theta_rad = 0.5f * float(i);
-    r.radius_m = kRobotRadius;
-    r.modes = {explorer, reconstructor};
-    robots_.push_back(r);
-  }
-  PlannerTask queued;
-  queued.position_m = Center(12, 6);
-  queued.mode = 1;
-  queued.tag = 99;
-  robots_[1].queue = {queued};
-  robots_[1].executing = true;
+  PlannerRobot r;
+  r.id = uint32_t(10 + robots_.size());
+  r.position_m = Center(ix, iy);
+  r.radius_m = radius_m;
+  r.modes = {explorer, reconstructor};
+  robots_.push_back(r);
+  return robots_.back();
 }
 
-FloorCell FakeWorld::CellAt(const Eigen::Vector2f& p) const {
+FloorCell RasterWorld::CellAt(const Eigen::Vector2f& p) const {
   const Eigen::Vector2i c = floor_.CellOf(p);
   return floor_.Contains(c.x(), c.y()) ? floor_.cells[floor_.Linear(c.x(), c.y())]
                                        : FloorCell::kUnknown;
 }
 
-PlannerMapInfo FakeWorld::MapInfo() const {
+PlannerMapInfo RasterWorld::MapInfo() const {
   PlannerMapInfo info;
   info.revision = 42;
   info.voxel_size_m = 0.05f;
   info.floor_z_m = 0.f;
   info.bounds_min = {0.f, 0.f, 0.f};
-  info.bounds_max = {kWidth * kCell, kHeight * kCell, 2.f};
+  info.bounds_max = {float(floor_.width) * floor_.cell_size_m,
+                     float(floor_.height) * floor_.cell_size_m, 2.f};
   return info;
 }
 
-void FakeWorld::VoxelStates(std::span<const Eigen::Vector3f> points,
-                            std::span<VoxelState> out) const {
+void RasterWorld::VoxelStates(std::span<const Eigen::Vector3f> points,
+                              std::span<VoxelState> out) const {
   for (size_t i = 0; i < points.size(); ++i) {
     const FloorCell c = CellAt(points[i].head<2>());
     out[i] = c == FloorCell::kObstacle  ? VoxelState::kOccupied
@@ -109,7 +105,7 @@ void FakeWorld::VoxelStates(std::span<const Eigen::Vector3f> points,
   }
 }
 
-void FakeWorld::Raycast(std::span<const PlannerRay> rays, std::span<PlannerRayHit> out) const {
+void RasterWorld::Raycast(std::span<const PlannerRay> rays, std::span<PlannerRayHit> out) const {
   constexpr float kStep = 0.01f;
   for (size_t i = 0; i < rays.size(); ++i) {
     PlannerRayHit hit;
@@ -133,10 +129,10 @@ void FakeWorld::Raycast(std::span<const PlannerRay> rays, std::span<PlannerRayHi
   }
 }
 
-std::vector<Eigen::Vector3f> FakeWorld::FrontierVoxels() const {
+std::vector<Eigen::Vector3f> RasterWorld::FrontierVoxels() const {
   std::vector<Eigen::Vector3f> v;
-  for (int y = 0; y < kHeight; ++y) {
-    for (int x = 0; x < kWidth; ++x) {
+  for (int y = 0; y < floor_.height; ++y) {
+    for (int x = 0; x < floor_.width; ++x) {
       if (floor_.cells[floor_.Linear(x, y)] == FloorCell::kFrontier) {
         v.emplace_back(Center(x, y).x(), Center(x, y).y(), 0.5f);
       }
@@ -145,12 +141,12 @@ std::vector<Eigen::Vector3f> FakeWorld::FrontierVoxels() const {
   return v;
 }
 
-std::vector<SurfaceVoxel> FakeWorld::SurfaceVoxels() const {
+std::vector<SurfaceVoxel> RasterWorld::SurfaceVoxels() const {
   // Obstacle cells with a free 4-neighbour, facing the first one found.
   std::vector<SurfaceVoxel> v;
   const int dirs[4][2] = {{1, 0}, {-1, 0}, {0, 1}, {0, -1}};
-  for (int y = 0; y < kHeight; ++y) {
-    for (int x = 0; x < kWidth; ++x) {
+  for (int y = 0; y < floor_.height; ++y) {
+    for (int x = 0; x < floor_.width; ++x) {
       if (floor_.cells[floor_.Linear(x, y)] != FloorCell::kObstacle) continue;
       for (const auto& d : dirs) {
         const int nx = x + d[0], ny = y + d[1];
@@ -158,8 +154,8 @@ std::vector<SurfaceVoxel> FakeWorld::SurfaceVoxels() const {
           SurfaceVoxel s;
           s.position = {Center(x, y).x(), Center(x, y).y(), 0.5f};
           s.normal = {float(d[0]), float(d[1]), 0.f};
-          s.uncertainty = 0.5f;
-          s.weight = 2.f;
+          s.uncertainty = 1.f / std::max(surface_weight_, 1e-6f);
+          s.weight = surface_weight_;
           v.push_back(s);
           break;
         }
@@ -167,6 +163,29 @@ std::vector<SurfaceVoxel> FakeWorld::SurfaceVoxels() const {
     }
   }
   return v;
+}
+
+FakeWorld::FakeWorld() : RasterWorld(kWidth, kHeight, kCell) {
+  Walls();
+  Fill(9, 0, 9, 4, FloorCell::kObstacle);  // wall with a door at y 5..7
+  Fill(9, 8, 9, kHeight - 1, FloorCell::kObstacle);
+  // The sealed pocket.
+  Fill(2, 6, 6, 6, FloorCell::kObstacle);
+  Fill(2, 10, 6, 10, FloorCell::kObstacle);
+  Fill(2, 6, 2, 10, FloorCell::kObstacle);
+  Fill(6, 6, 6, 10, FloorCell::kObstacle);
+  Fill(13, 1, 17, 4, FloorCell::kUnknown);
+  Finish();
+
+  AddRobot(3, 2, kRobotRadius);
+  PlannerRobot& r1 = AddRobot(14, 8, kRobotRadius);
+  r1.theta_rad = 0.5f;
+  PlannerTask queued;
+  queued.position_m = Center(12, 6);
+  queued.mode = 1;
+  queued.tag = 99;
+  r1.queue = {queued};
+  r1.executing = true;
 }
 
 std::vector<ObjectInstance> FakeWorld::Instances() const {
@@ -178,6 +197,55 @@ std::vector<ObjectInstance> FakeWorld::Instances() const {
   chair.bbox_max = {1.5f, 1.5f, 0.9f};
   chair.completeness = 0.25f;
   return {chair};
+}
+
+RasterWorld ApartmentWorld(float width_m, float height_m, float cell_m, int robots, float known_x_m,
+                           float room_m) {
+  const int w = int(std::lround(width_m / cell_m)), h = int(std::lround(height_m / cell_m));
+  RasterWorld world(w, h, cell_m);
+  world.Fill(0, 0, w - 1, 1, FloorCell::kObstacle);
+  world.Fill(0, h - 2, w - 1, h - 1, FloorCell::kObstacle);
+  world.Fill(0, 0, 1, h - 1, FloorCell::kObstacle);
+  world.Fill(w - 2, 0, w - 1, h - 1, FloorCell::kObstacle);
+  const int cols = std::max(1, int(std::lround(width_m / room_m)));
+  const int rows = std::max(1, int(std::lround(height_m / room_m)));
+  const int door = int(std::lround(1.0f / cell_m));
+  std::vector<int> xs{0}, ys{0};  // room borders in cells
+  for (int c = 1; c <= cols; ++c) xs.push_back(c * w / cols);
+  for (int r = 1; r <= rows; ++r) ys.push_back(r * h / rows);
+  for (int c = 1; c < cols; ++c) {  // vertical walls, a door in every room's stretch
+    world.Fill(xs[c] - 1, 0, xs[c], h - 1, FloorCell::kObstacle);
+    for (int r = 0; r < rows; ++r) {
+      const int mid = (ys[r] + ys[r + 1]) / 2;
+      world.Fill(xs[c] - 1, mid - door / 2, xs[c], mid - door / 2 + door - 1, FloorCell::kFree);
+    }
+  }
+  for (int r = 1; r < rows; ++r) {  // horizontal walls, likewise
+    for (int c = 0; c < cols; ++c) {
+      world.Fill(xs[c] + 1, ys[r] - 1, xs[c + 1] - 2, ys[r], FloorCell::kObstacle);
+      const int mid = (xs[c] + xs[c + 1]) / 2;
+      world.Fill(mid - door / 2, ys[r] - 1, mid - door / 2 + door - 1, ys[r], FloorCell::kFree);
+    }
+  }
+  const int known_cells = int(std::lround(known_x_m / cell_m));
+  world.Fill(known_cells, 0, w - 1, h - 1, FloorCell::kUnknown);
+  world.Finish();
+  // Robots at the centres of the known rooms, round robin, 0.5 m apart within a room.
+  std::vector<Eigen::Vector2i> centres;
+  for (int r = 0; r < rows; ++r) {
+    for (int c = 0; c < cols; ++c) {
+      const Eigen::Vector2i m((xs[c] + xs[c + 1]) / 2, (ys[r] + ys[r + 1]) / 2);
+      if (m.x() + int(0.5f / cell_m) < known_cells) centres.push_back(m);
+    }
+  }
+  if (centres.empty()) centres.push_back({known_cells / 2, h / 2});
+  const int step = int(std::lround(0.5f / cell_m));
+  for (int i = 0; i < robots; ++i) {
+    const Eigen::Vector2i m = centres[size_t(i) % centres.size()];
+    const int k = i / int(centres.size());
+    world.AddRobot(m.x() + (k % 2 ? -1 : 1) * ((k + 1) / 2) * step, m.y(), 0.18f);
+  }
+  return world;
 }
 
 }  // namespace voxplan::test

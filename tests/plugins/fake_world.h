@@ -1,7 +1,15 @@
 #pragma once
-// A small grid world for the plugin host tests: 20 x 12 floor cells of 0.25 m, two rooms joined
-// by a 3-cell door, an enclosed free pocket no robot can reach, and an unknown patch in the right
-// room whose free neighbours are frontier. Voxel states and rays read the floor column at any z.
+// Grid worlds for the plugin host and planner tests.
+//
+// RasterWorld: a PlannerWorld over a floor raster of any size drawn from rectangles. Voxel states
+// and rays read the floor column at any z; surface voxels are the obstacle cells with a free
+// 4-neighbour (at z 0.5 m, facing that neighbour, one weight for all); frontier cells (free and
+// 8-adjacent to unknown) and clearance (cell centre to the nearest obstacle cell centre) are
+// derived by Finish(), which must follow the drawing.
+//
+// FakeWorld: a small hand-made RasterWorld, 20 x 12 floor cells of 0.25 m, two rooms joined by a
+// 3-cell door, an enclosed free pocket no robot can reach, and an unknown patch in the right room
+// whose free neighbours are frontier.
 //
 //   y=11  ####################    # obstacle   . free   ? unknown   f frontier
 //   y=10  #.#####..#.........#    0, 1 the robots (radius 0.3 m: a cell next to a wall,
@@ -22,13 +30,21 @@
 
 namespace voxplan::test {
 
-class FakeWorld : public PlannerWorld {
+class RasterWorld : public PlannerWorld {
  public:
-  static constexpr int kWidth = 20, kHeight = 12;
-  static constexpr float kCell = 0.25f;
-  static constexpr float kRobotRadius = 0.3f;  // a cell next to a wall (0.25 m) is too close
+  // All cells free until drawn; the raster's origin is the world origin.
+  RasterWorld(int width, int height, float cell_m);
 
-  FakeWorld();
+  // Sets the cells x0..x1, y0..y1 (inclusive, clipped to the raster).
+  void Fill(int x0, int y0, int x1, int y1, FloorCell cell);
+  // Obstacle cells on the raster's border.
+  void Walls();
+  // Derives frontier cells and clearance from the drawing; call again after drawing more.
+  void Finish();
+  // A robot of the given radius at a cell centre, with an explorer (0.6 m/s) and a
+  // reconstructor (0.2 m/s) mode; idle with an empty queue.
+  PlannerRobot& AddRobot(int ix, int iy, float radius_m);
+  void set_surface_weight(float weight) { surface_weight_ = weight; }
 
   PlannerMapInfo MapInfo() const override;
   void VoxelStates(std::span<const Eigen::Vector3f> points,
@@ -37,7 +53,6 @@ class FakeWorld : public PlannerWorld {
   std::vector<Eigen::Vector3f> FrontierVoxels() const override;
   std::vector<SurfaceVoxel> SurfaceVoxels() const override;
   const PlannerFloor& Floor() const override { return floor_; }
-  std::vector<ObjectInstance> Instances() const override;
   std::vector<PlannerRobot> Robots() const override { return robots_; }
 
   // Cell centre in world metres.
@@ -45,9 +60,26 @@ class FakeWorld : public PlannerWorld {
   FloorCell CellAt(const Eigen::Vector2f& p) const;
   std::vector<PlannerRobot>& robots() { return robots_; }
 
- private:
+ protected:
   PlannerFloor floor_;
   std::vector<PlannerRobot> robots_;
+  float surface_weight_ = 2.f;
 };
+
+class FakeWorld : public RasterWorld {
+ public:
+  static constexpr int kWidth = 20, kHeight = 12;
+  static constexpr float kCell = 0.25f;
+  static constexpr float kRobotRadius = 0.3f;  // a cell next to a wall (0.25 m) is too close
+
+  FakeWorld();
+  std::vector<ObjectInstance> Instances() const override;
+};
+
+// An apartment for planner tests and timing: border and room walls 2 cells thick, rooms about
+// room_m wide joined by 1 m doors, everything from known_x_m on unknown, and `robots` robots of
+// radius 0.18 m spread over the known rooms' centres (deterministic). Finished.
+RasterWorld ApartmentWorld(float width_m, float height_m, float cell_m, int robots, float known_x_m,
+                           float room_m = 3.75f);
 
 }  // namespace voxplan::test

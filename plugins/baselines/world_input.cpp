@@ -1,0 +1,272 @@
+#include "plugins/baselines/world_input.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <limits>
+#include <utility>
+
+#include "plugins/omt/raster_ops.h"
+
+namespace voxplan::planners {
+
+// ---- JsonOptions. ------------------------------------------------------------------------
+
+JsonOptions::JsonOptions(std::string planner, const std::string& json_text)
+    : planner_(std::move(planner)) {
+  try {
+    json_ = nlohmann::json::parse(json_text.empty() ? std::string("{}") : json_text);
+  } catch (const nlohmann::json::exception& e) {
+    throw vp::Error(VP_ERROR_INVALID_ARGUMENT,
+                    planner_ + ": config is not valid JSON: " + std::string(e.what()));
+  }
+  if (!json_.is_object()) {
+    throw vp::Error(VP_ERROR_INVALID_ARGUMENT, planner_ + ": config must be a JSON object");
+  }
+}
+
+void JsonOptions::Fail(const std::string& key, const std::string& why) const {
+  throw vp::Error(VP_ERROR_INVALID_ARGUMENT, planner_ + ": config key '" + key + "' " + why);
+}
+
+const nlohmann::json* JsonOptions::Find(const std::string& key) {
+  read_.insert(key);
+  const auto it = json_.find(key);
+  return it == json_.end() ? nullptr : &*it;
+}
+
+double JsonOptions::Number(const std::string& key, double fallback, double min, double max) {
+  const nlohmann::json* v = Find(key);
+  if (v == nullptr) return fallback;
+  if (!v->is_number()) Fail(key, "must be a number");
+  const double x = v->get<double>();
+  if (!std::isfinite(x) || x < min || x > max) {
+    Fail(key, "must lie in [" + std::to_string(min) + ", " + std::to_string(max) + "]");
+  }
+  return x;
+}
+
+int JsonOptions::Integer(const std::string& key, int fallback, int min, int max) {
+  const nlohmann::json* v = Find(key);
+  if (v == nullptr) return fallback;
+  if (!v->is_number_integer()) Fail(key, "must be an integer");
+  const long long x = v->get<long long>();
+  if (x < min || x > max) {
+    Fail(key, "must lie in [" + std::to_string(min) + ", " + std::to_string(max) + "]");
+  }
+  return int(x);
+}
+
+bool JsonOptions::Flag(const std::string& key, bool fallback) {
+  const nlohmann::json* v = Find(key);
+  if (v == nullptr) return fallback;
+  if (!v->is_boolean()) Fail(key, "must be true or false");
+  return v->get<bool>();
+}
+
+std::string JsonOptions::Choice(const std::string& key, const std::string& fallback,
+                                const std::vector<std::string>& allowed) {
+  const nlohmann::json* v = Find(key);
+  if (v == nullptr) return fallback;
+  std::string names;
+  for (const std::string& a : allowed) names += (names.empty() ? "\"" : ", \"") + a + "\"";
+  if (!v->is_string()) Fail(key, "must be one of " + names);
+  const std::string s = v->get<std::string>();
+  if (std::find(allowed.begin(), allowed.end(), s) == allowed.end()) {
+    Fail(key, "must be one of " + names + ", not \"" + s + "\"");
+  }
+  return s;
+}
+
+void JsonOptions::RejectUnknownKeys() const {
+  for (const auto& item : json_.items()) {
+    if (!read_.count(item.key())) Fail(item.key(), "is unknown");
+  }
+}
+
+CommonOptions ReadCommonOptions(JsonOptions& json) {
+  CommonOptions o;
+  o.omt.kappa = json.Integer("kappa", o.omt.kappa, 1, 1000);
+  o.omt.importance_threshold =
+      json.Number("importance_threshold", o.omt.importance_threshold, 0.0, 1e9);
+  o.omt.geodesic_cell_m = json.Number("geodesic_cell_m", o.omt.geodesic_cell_m, 1e-3, 10.0);
+  o.omt.num_threads = json.Integer("num_threads", o.omt.num_threads, 1, 256);
+  o.robot_radius_m = json.Number("robot_radius_m", o.robot_radius_m, 0.0, 10.0);
+  o.clearance_margin_m = json.Number("clearance_margin_m", o.clearance_margin_m, 0.0, 10.0);
+  o.dwell_s = json.Number("dwell_s", o.dwell_s, 0.0, 600.0);
+  o.surface_min_height_m =
+      json.Number("surface_min_height_m", o.surface_min_height_m, -100.0, 100.0);
+  o.omt.views.uncertainty.weight_scale =
+      json.Number("weight_scale", o.omt.views.uncertainty.weight_scale, 1e-6, 1e9);
+  o.geodesics = json.Choice("geodesics", o.geodesics, {"host", "internal"});
+  return o;
+}
+
+// ---- The world as OMT inputs. ------------------------------------------------------------
+
+WorldInput ReadWorld(const vp::WorldView& world, const CommonOptions& options) {
+  WorldInput in;
+  in.map = world.MapInfo();
+  const vp::FloorView floor = world.Floor();
+  if (floor.width() <= 0 || floor.height() <= 0 || !(floor.cell_size_m() > 0.f)) {
+    throw vp::Error(VP_ERROR_NOT_AVAILABLE, "the world has no floor raster");
+  }
+  omt::RasterGeometry& g = in.raster.geometry;
+  g.width = floor.width();
+  g.height = floor.height();
+  g.resolution_m = floor.cell_size_m();
+  g.origin_m = {floor.raw().origin_x_m, floor.raw().origin_y_m};
+  const size_t n = floor.size();
+  in.raster.cells.resize(n);
+  for (size_t i = 0; i < n; ++i) {
+    const uint8_t c = floor.cells()[i];
+    in.raster.cells[i] = c == VP_FLOOR_OBSTACLE                           ? omt::Cell::kOccupied
+                         : (c == VP_FLOOR_FREE || c == VP_FLOOR_FRONTIER) ? omt::Cell::kFree
+                                                                          : omt::Cell::kUnknown;
+  }
+  in.clearance.geometry = g;
+  // +inf (no obstacle at all) would turn the path smoother's interpolation into NaN; nothing
+  // is farther than the raster's diagonal anyway.
+  const float max_clearance_m = float(std::hypot(g.width, g.height) * g.resolution_m);
+  in.clearance.clearance_m.resize(n);
+  for (size_t i = 0; i < n; ++i) {
+    const float c = floor.clearance_m()[i];
+    in.clearance.clearance_m[i] = std::isnan(c) ? 0.f : std::min(c, max_clearance_m);
+  }
+
+  // Surface weight per obstacle cell: mean over the surface voxels standing on it (floor voxels,
+  // below surface_min_height_m, belong to the floor, not to the obstacle).
+  std::vector<double> weight_sum(n, 0.0);
+  std::vector<uint32_t> weight_count(n, 0);
+  const float min_z = in.map.floor_z_m + float(options.surface_min_height_m);
+  for (const vp_surface_voxel& s : world.SurfaceVoxels()) {
+    if (!(s.position[2] >= min_z) || !std::isfinite(s.weight)) continue;
+    const auto [ix, iy] = floor.CellOf(s.position[0], s.position[1]);
+    if (!floor.Contains(ix, iy)) continue;
+    const size_t i = floor.Linear(ix, iy);
+    if (in.raster.cells[i] != omt::Cell::kOccupied) continue;
+    weight_sum[i] += std::max(0.f, s.weight);
+    ++weight_count[i];
+  }
+  in.raster.tsdf_weight.assign(n, 0.f);
+  for (size_t i = 0; i < n; ++i) {
+    if (weight_count[i] > 0) in.raster.tsdf_weight[i] = float(weight_sum[i] / weight_count[i]);
+  }
+
+  float max_radius_m = 0.f;
+  for (uint32_t r = 0; r < world.RobotCount(); ++r) {
+    const vp_robot robot = world.Robot(r);
+    omt::RobotState state;
+    state.position_m = {robot.x_m, robot.y_m};
+    state.yaw_rad = omt::WrapAngle(double(robot.theta_rad) + robot.camera_yaw_rad);
+    if (robot.mode >= 0 && uint32_t(robot.mode) < robot.mode_count) {
+      const float speed = world.Mode(r, uint32_t(robot.mode)).max_speed_mps;
+      if (std::isfinite(speed) && speed > 0.f) state.speed_mps = speed;
+    }
+    max_radius_m = std::max(max_radius_m, robot.radius_m);
+    in.robots.push_back(robot);
+    in.states.push_back(state);
+  }
+  in.robot_radius_m = options.robot_radius_m > 0.0 ? options.robot_radius_m : double(max_radius_m);
+  in.min_clearance_m = float(in.robot_radius_m + options.clearance_margin_m);
+
+  // The host's clearance ignores unknown space, but the algorithms' internal grid and path
+  // smoothing only look at clearance: capped at (distance to unknown + radius) they never route
+  // through unknown cells (which the host would not traverse), views keep half a radius from
+  // unknown, and the cap stays 1-Lipschitz as the grid's edge test assumes.
+  if (std::find(in.raster.cells.begin(), in.raster.cells.end(), omt::Cell::kUnknown) !=
+      in.raster.cells.end()) {
+    const omt::ClearanceRaster known =
+        omt::ComputeClearance(in.raster, /*unknown_is_obstacle=*/true);
+    for (size_t i = 0; i < n; ++i) {
+      in.clearance.clearance_m[i] =
+          std::min(in.clearance.clearance_m[i], known.clearance_m[i] + float(in.robot_radius_m));
+    }
+  }
+  return in;
+}
+
+omt::PlannerOptions PassOptions(const CommonOptions& options, const WorldInput& input) {
+  omt::PlannerOptions o = options.omt;
+  o.robot_radius_m = input.robot_radius_m;
+  return o;
+}
+
+omt::GeodesicProvider HostGeodesics(const vp::WorldView& world, float min_clearance_m,
+                                    double* host_ms) {
+  using Clock = std::chrono::steady_clock;
+  const auto add_ms = [host_ms](Clock::time_point start) {
+    *host_ms += std::chrono::duration<double, std::milli>(Clock::now() - start).count();
+  };
+  omt::GeodesicProvider p;
+  p.distance_matrix = [&world, min_clearance_m, add_ms](const std::vector<Eigen::Vector2d>& points,
+                                                        omt::DistanceMatrix* out) {
+    const auto start = Clock::now();
+    std::vector<float> xy;
+    for (const Eigen::Vector2d& q : points) xy.insert(xy.end(), {float(q.x()), float(q.y())});
+    const std::span<const float> m = world.DistanceMatrix(xy, min_clearance_m);
+    const int count = int(points.size());
+    *out = omt::DistanceMatrix(count, count);
+    for (size_t i = 0; i < m.size(); ++i) out->values[i] = double(m[i]);
+    add_ms(start);
+    return true;
+  };
+  p.shortest_path = [&world, min_clearance_m, add_ms](const Eigen::Vector2d& a,
+                                                      const Eigen::Vector2d& b,
+                                                      std::vector<Eigen::Vector2d>* out) {
+    const auto start = Clock::now();
+    const auto path =
+        world.ShortestPath(float(a.x()), float(a.y()), float(b.x()), float(b.y()), min_clearance_m);
+    out->clear();
+    if (path) {
+      for (size_t i = 0; i + 1 < path->size(); i += 2) {
+        out->emplace_back((*path)[i], (*path)[i + 1]);
+      }
+    }
+    add_ms(start);
+    return !out->empty();
+  };
+  return p;
+}
+
+// ---- Output. -----------------------------------------------------------------------------
+
+std::vector<vp_path_point> PathWithHeadings(const std::vector<Eigen::Vector2d>& points_m,
+                                            double start_theta_rad) {
+  // Steps shorter than this keep the previous heading (a direction from noise is meaningless).
+  constexpr double kMinStepM = 1e-4;
+  std::vector<vp_path_point> path;
+  double theta = start_theta_rad;
+  for (size_t i = 0; i < points_m.size(); ++i) {
+    if (i > 0) {
+      const Eigen::Vector2d step = points_m[i] - points_m[i - 1];
+      if (step.norm() > kMinStepM) theta = std::atan2(step.y(), step.x());
+    }
+    path.push_back({float(points_m[i].x()), float(points_m[i].y()), float(theta)});
+  }
+  return path;
+}
+
+vp_task TaskFromView(const omt::TaskView& view, double theta_rad, const vp_robot& robot,
+                     double dwell_s) {
+  vp_task t{};
+  t.x_m = float(view.position_m.x());
+  t.y_m = float(view.position_m.y());
+  t.theta_rad = float(omt::WrapAngle(theta_rad));
+  t.camera_yaw_rad = float(omt::WrapAngle(view.yaw_rad - theta_rad));
+  t.camera_pitch_rad = std::clamp(0.f, robot.min_pitch_rad, robot.max_pitch_rad);
+  t.dwell_s = float(dwell_s);
+  t.mode = robot.mode >= 0 && uint32_t(robot.mode) < robot.mode_count ? robot.mode : 0;
+  t.tag = uint32_t(std::max(view.target_cell, 0));
+  return t;
+}
+
+std::vector<float> ViewPointsXyz(const std::vector<omt::TaskView>& views, float z_m) {
+  std::vector<float> xyz;
+  for (const omt::TaskView& v : views) {
+    xyz.insert(xyz.end(), {float(v.position_m.x()), float(v.position_m.y()), z_m});
+  }
+  return xyz;
+}
+
+}  // namespace voxplan::planners

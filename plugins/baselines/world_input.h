@@ -1,0 +1,93 @@
+// Plugin-side glue shared by the omt, greedy and voronoi planners: the host's world, read
+// through vp::WorldView only, as the OMT algorithms' inputs (plugins/omt/types.h); their JSON
+// options; tasks and paths for the output. Links no voxplan library, like every plugin.
+#pragma once
+
+#include <Eigen/Core>
+#include <cstdint>
+#include <nlohmann/json.hpp>
+#include <set>
+#include <string>
+#include <vector>
+
+#include "plugins/omt/planner.h"
+#include "plugins/planner_cpp.h"
+
+namespace voxplan::planners {
+
+// A planner's JSON options: typed reads with defaults and ranges. Invalid JSON, a wrong type, a
+// value out of range and a key no read asked for are refused with a vp::Error naming the planner
+// and the key, so a typo in a config never passes silently.
+class JsonOptions {
+ public:
+  JsonOptions(std::string planner, const std::string& json_text);
+  double Number(const std::string& key, double fallback, double min, double max);
+  int Integer(const std::string& key, int fallback, int min, int max);
+  bool Flag(const std::string& key, bool fallback);
+  std::string Choice(const std::string& key, const std::string& fallback,
+                     const std::vector<std::string>& allowed);
+  // Throws for keys none of the reads above asked for; call after the last read.
+  void RejectUnknownKeys() const;
+
+ private:
+  [[noreturn]] void Fail(const std::string& key, const std::string& why) const;
+  const nlohmann::json* Find(const std::string& key);
+
+  std::string planner_;
+  nlohmann::json json_;
+  std::set<std::string> read_;
+};
+
+// Options all three planners share; JSON keys are the member names.
+struct CommonOptions {
+  // kappa, importance_threshold, geodesic_cell_m, num_threads (and, for omt, the ablations).
+  omt::PlannerOptions omt;
+  double robot_radius_m = 0.0;        // <= 0: the largest robot radius of the world
+  double clearance_margin_m = 0.0;    // added to the radius for the host's geodesic queries
+  double dwell_s = 0.5;               // standing time at a view, so the sensor takes it in
+  double surface_min_height_m = 0.1;  // surface voxels lower than this above the floor are floor
+  // Geodesics of the omt pass: "host" (distance_matrix / shortest_path, the distances the host
+  // validates with) or "internal" (the algorithms' own coarse grid, faster on big floors).
+  std::string geodesics = "host";
+};
+CommonOptions ReadCommonOptions(JsonOptions& json);
+
+struct WorldInput {
+  vp_map_info map{};
+  std::vector<vp_robot> robots;
+  std::vector<omt::RobotState> states;  // position, camera world yaw, speed of the current mode
+  // The floor raster: obstacle -> occupied, free and frontier -> free, unknown -> unknown; per
+  // obstacle cell the mean TSDF weight of the surface voxels above it (the §3.2 uncertainty
+  // 1 / (1 + w) of the slice the robot sees; 0, i.e. unscanned, when it has none).
+  omt::OccupancyRaster raster;
+  omt::ClearanceRaster clearance;  // the host's: distance to the nearest obstacle cell
+  double robot_radius_m = 0.0;     // views, paths and the internal grid keep this
+  float min_clearance_m = 0.f;     // for host geodesic queries: robot_radius_m + margin
+};
+// vp::Error for a floor raster without cells.
+WorldInput ReadWorld(const vp::WorldView& world, const CommonOptions& options);
+
+// options.omt with this world's robot radius.
+omt::PlannerOptions PassOptions(const CommonOptions& options, const WorldInput& input);
+
+// The host's distance_matrix / shortest_path as the OMT pass's geodesics; *host_ms accumulates
+// the milliseconds spent inside those host calls.
+omt::GeodesicProvider HostGeodesics(const vp::WorldView& world, float min_clearance_m,
+                                    double* host_ms);
+
+// Base heading into each polyline point: the direction of the segment arriving there (the first
+// point, and points after a zero-length step, keep the previous heading, starting from
+// start_theta_rad).
+std::vector<vp_path_point> PathWithHeadings(const std::vector<Eigen::Vector2d>& points_m,
+                                            double start_theta_rad);
+
+// The task of standing at `view` with the base at theta_rad (the direction of travel), the
+// camera turned so it looks at the view's target, pitch level (within the robot's limits), in
+// the robot's current mode. tag = the view's target cell, so a later call can recognise it.
+vp_task TaskFromView(const omt::TaskView& view, double theta_rad, const vp_robot& robot,
+                     double dwell_s);
+
+// Points of a view layer for the debug drawing: view positions at the robot's camera height.
+std::vector<float> ViewPointsXyz(const std::vector<omt::TaskView>& views, float z_m);
+
+}  // namespace voxplan::planners

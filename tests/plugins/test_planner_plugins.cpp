@@ -1,0 +1,338 @@
+// The real planner plugins (omt, greedy, voronoi) through the host: loading by name, valid tasks
+// on grid worlds (the host's validation rejects none), determinism, termination on an explored
+// world, and each baseline's defining rule (GRD: distinct views; SEG: each view to its nearest
+// robot).
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstring>
+#include <map>
+#include <set>
+#include <string>
+#include <vector>
+
+#include "plugins/host/plugin_host.h"
+#include "tests/plugins/fake_world.h"
+
+namespace voxplan {
+namespace {
+
+const std::vector<std::string> kPlanners = {"omt", "greedy", "voronoi"};
+// Angles and positions travel as floats through the C boundary.
+constexpr float kAngleTol = 1e-3f;
+
+std::unique_ptr<LoadedPlanner> MustLoad(const std::string& name, const std::string& config = "{}",
+                                        uint64_t seed = 1) {
+  PlannerLoadOptions o;
+  o.config_json = config;
+  o.seed = seed;
+  auto planner = LoadPlanner(name, o);
+  EXPECT_TRUE(planner.ok()) << name << ": " << planner.status().message();
+  return planner.ok() ? std::move(planner).value() : nullptr;
+}
+
+PlanResult MustPlan(LoadedPlanner& planner, const PlannerWorld& world, const PlanRequest& r = {}) {
+  auto result = planner.Plan(world, r);
+  EXPECT_TRUE(result.ok()) << planner.name() << ": " << result.status().message();
+  if (!result.ok()) return {};
+  for (const Rejection& j : result->rejections) {
+    ADD_FAILURE() << planner.name() << ": robot " << j.robot << " task " << j.task << ": "
+                  << j.reason;
+  }
+  return std::move(result).value();
+}
+
+std::map<std::string, double> Diagnostics(const PlanResult& r) {
+  return {r.diagnostics.begin(), r.diagnostics.end()};
+}
+
+// A world of 8 x 6 m at 5 cm: six rooms, the right third unknown, three robots.
+test::RasterWorld SmallApartment() { return test::ApartmentWorld(8.f, 6.f, 0.05f, 3, 5.5f, 2.7f); }
+
+// Every task field, byte for byte, then the paths: the whole observable plan.
+std::vector<uint8_t> Bytes(const PlanResult& r) {
+  std::vector<uint8_t> bytes;
+  auto put = [&](const void* p, size_t n) {
+    const auto* b = static_cast<const uint8_t*>(p);
+    bytes.insert(bytes.end(), b, b + n);
+  };
+  for (const RobotPlan& plan : r.robots) {
+    put(&plan.policy, sizeof plan.policy);
+    for (const PlannerTask& t : plan.tasks) {
+      put(t.position_m.data(), 2 * sizeof(float));
+      put(&t.theta_rad, sizeof(float));
+      put(&t.camera_yaw_rad, sizeof(float));
+      put(&t.camera_pitch_rad, sizeof(float));
+      put(&t.dwell_s, sizeof(float));
+      put(&t.mode, sizeof t.mode);
+      put(&t.tag, sizeof t.tag);
+    }
+    for (const PathPoint& p : plan.path) {
+      put(p.position_m.data(), 2 * sizeof(float));
+      put(&p.theta_rad, sizeof(float));
+    }
+    for (const CameraSample& s : plan.camera_trajectory) {
+      put(&s.t_s, sizeof(float));
+      put(s.position_m.data(), 3 * sizeof(float));
+      put(&s.yaw_rad, sizeof(float));
+    }
+  }
+  bytes.push_back(r.done ? 1 : 0);
+  return bytes;
+}
+
+// The tag is the view's target cell: the camera (base heading + camera yaw) must face it.
+void ExpectCameraFacesTarget(const PlannerWorld& world, const PlannerTask& t) {
+  const PlannerFloor& floor = world.Floor();
+  ASSERT_LT(t.tag, floor.cells.size());
+  const Eigen::Vector2f target =
+      floor.CellCenter(int(t.tag % uint32_t(floor.width)), int(t.tag / uint32_t(floor.width)));
+  const Eigen::Vector2f d = target - t.position_m;
+  const float want = std::atan2(d.y(), d.x());
+  const float got = t.theta_rad + t.camera_yaw_rad;
+  EXPECT_NEAR(std::remainder(got - want, 2.f * float(M_PI)), 0.f, kAngleTol);
+}
+
+TEST(Planners, LoadByNameWithVersions) {
+  for (const std::string& name : kPlanners) {
+    auto planner = MustLoad(name);
+    ASSERT_TRUE(planner);
+    EXPECT_EQ(planner->name(), name);
+    EXPECT_EQ(planner->version(), "1.0.0");
+  }
+}
+
+TEST(Planners, BadConfigsAreRefusedNamingTheKey) {
+  for (const std::string& name : kPlanners) {
+    PlannerLoadOptions o;
+    o.config_json = R"({"kapa": 6})";
+    auto typo = LoadPlanner(name, o);
+    ASSERT_FALSE(typo.ok());
+    EXPECT_NE(typo.status().message().find("'kapa' is unknown"), std::string::npos)
+        << typo.status().message();
+    o.config_json = R"({"kappa": "six"})";
+    EXPECT_FALSE(LoadPlanner(name, o).ok());
+    o.config_json = "{kappa";
+    auto garbage = LoadPlanner(name, o);
+    ASSERT_FALSE(garbage.ok());
+    EXPECT_NE(garbage.status().message().find("not valid JSON"), std::string::npos);
+  }
+}
+
+TEST(Planners, EveryRobotGetsValidTasksOnTheApartment) {
+  const test::RasterWorld world = SmallApartment();
+  std::set<double> view_counts;  // the baselines plan over the OMT pass's own views
+  for (const std::string& name : kPlanners) {
+    auto planner = MustLoad(name);
+    ASSERT_TRUE(planner);
+    const PlanResult r = MustPlan(*planner, world);
+    SCOPED_TRACE(name);
+    EXPECT_FALSE(r.done);
+    ASSERT_EQ(r.robots.size(), 3u);
+    int robots_with_tasks = 0;
+    for (size_t i = 0; i < r.robots.size(); ++i) {
+      const RobotPlan& plan = r.robots[i];
+      EXPECT_EQ(plan.policy, TaskPolicy::kReplace);
+      if (plan.tasks.empty()) continue;
+      ++robots_with_tasks;
+      ASSERT_GE(plan.path.size(), 2u);
+      EXPECT_TRUE(plan.path.front().position_m.isApprox(world.Robots()[i].position_m));
+      for (const PlannerTask& t : plan.tasks) ExpectCameraFacesTarget(world, t);
+    }
+    const auto d = Diagnostics(r);
+    if (name == "greedy") {
+      EXPECT_EQ(robots_with_tasks, 3);  // more important views than robots, all reachable
+    } else if (name == "voronoi") {
+      for (size_t i = 0; i < r.robots.size(); ++i) {  // exactly the robots owning a view
+        EXPECT_EQ(r.robots[i].tasks.empty(), d.at("region_views_" + std::to_string(i)) == 0.0);
+      }
+    } else {
+      EXPECT_GE(robots_with_tasks, 2);  // OMT's refinement may leave a robot without a cluster
+    }
+    EXPECT_GT(d.at("views"), 0.0);
+    EXPECT_GE(d.at("plan_ms"), 0.0);
+    view_counts.insert(d.at("views"));
+  }
+  EXPECT_EQ(view_counts.size(), 1u);
+}
+
+TEST(Planners, ValidTasksOnTheSmallFakeWorld) {
+  // Coarse 0.25 m cells, a wide robot, a sealed pocket and an executing robot: nothing the
+  // planners return may be rejected.
+  const test::FakeWorld world;
+  for (const std::string& name : kPlanners) {
+    auto planner = MustLoad(name);
+    ASSERT_TRUE(planner);
+    const PlanResult r = MustPlan(*planner, world);
+    SCOPED_TRACE(name);
+    size_t tasks = 0;
+    for (const RobotPlan& plan : r.robots) tasks += plan.tasks.size();
+    EXPECT_GT(tasks, 0u);
+  }
+}
+
+TEST(Planners, OmtCameraTrajectoryFollowsThePathInTime) {
+  const test::RasterWorld world = SmallApartment();
+  auto planner = MustLoad("omt");
+  ASSERT_TRUE(planner);
+  const PlanResult r = MustPlan(*planner, world);
+  for (const RobotPlan& plan : r.robots) {
+    if (plan.tasks.empty()) continue;
+    ASSERT_GE(plan.camera_trajectory.size(), plan.path.size());
+    EXPECT_EQ(plan.camera_trajectory.front().t_s, 0.f);
+    EXPECT_GT(plan.camera_trajectory.back().t_s, 0.f);
+    // Yaw at the last view is that view's camera direction.
+    const PlannerTask& last = plan.tasks.back();
+    EXPECT_NEAR(std::remainder(
+                    plan.camera_trajectory.back().yaw_rad - (last.theta_rad + last.camera_yaw_rad),
+                    2.f * float(M_PI)),
+                0.f, kAngleTol);
+  }
+  const auto d = Diagnostics(r);
+  for (const char* key : {"omt_ms", "input_ms", "output_ms", "assignment_energy", "tasks"}) {
+    EXPECT_TRUE(d.count(key)) << key;
+  }
+}
+
+TEST(Planners, OmtAblationsAndInternalGeodesicsPlanValidTasks) {
+  const test::RasterWorld world = SmallApartment();
+  for (const char* config :
+       {R"({"use_task_views": false, "use_tsp": false, "refine": false, "optimize_paths": false})",
+        R"({"geodesics": "internal", "kappa": 4})"}) {
+    auto planner = MustLoad("omt", config);
+    ASSERT_TRUE(planner);
+    const PlanResult r = MustPlan(*planner, world);
+    size_t tasks = 0;
+    for (const RobotPlan& plan : r.robots) tasks += plan.tasks.size();
+    EXPECT_GT(tasks, 0u) << config;
+  }
+}
+
+TEST(Planners, SameSeedSameWorldSameBytes) {
+  const test::RasterWorld world = SmallApartment();
+  for (const std::string& name : kPlanners) {
+    auto a = MustLoad(name, "{}", 5);
+    auto b = MustLoad(name, "{}", 5);
+    ASSERT_TRUE(a && b);
+    PlanRequest request;
+    request.seed = 11;
+    const std::vector<uint8_t> first = Bytes(MustPlan(*a, world, request));
+    EXPECT_GT(first.size(), 1u);
+    EXPECT_EQ(first, Bytes(MustPlan(*b, world, request))) << name;
+  }
+}
+
+TEST(Planners, DoneOnAFullyExploredWorld) {
+  // No unknown cell, every surface scanned a thousand times: nothing is worth a view.
+  test::RasterWorld world = test::ApartmentWorld(6.f, 4.f, 0.05f, 2, 6.f, 3.f);
+  world.set_surface_weight(1000.f);
+  for (const std::string& name : kPlanners) {
+    auto planner = MustLoad(name);
+    ASSERT_TRUE(planner);
+    const PlanResult r = MustPlan(*planner, world);
+    EXPECT_TRUE(r.done) << name;
+    for (const RobotPlan& plan : r.robots) EXPECT_TRUE(plan.tasks.empty()) << name;
+  }
+}
+
+TEST(Planners, NotDoneWhileNoRobotStandsOnKnownFreeSpace) {
+  // A robot in a 0.3 m patch of known floor amid unknown space: nothing can be judged yet, which
+  // must not read as "explored".
+  test::RasterWorld world(60, 60, 0.05f);
+  world.Fill(0, 0, 59, 59, FloorCell::kUnknown);
+  world.Fill(27, 27, 32, 32, FloorCell::kFree);
+  world.Finish();
+  world.AddRobot(30, 30, 0.18f);
+  for (const std::string& name : kPlanners) {
+    auto planner = MustLoad(name);
+    ASSERT_TRUE(planner);
+    const PlanResult r = MustPlan(*planner, world);
+    EXPECT_FALSE(r.done) << name;
+    EXPECT_TRUE(r.robots[0].tasks.empty()) << name;
+  }
+}
+
+TEST(Planners, GreedyGivesDistinctRobotsDistinctViews) {
+  // Four robots, two per room: the pairs start at the same nearest view and must split.
+  const test::RasterWorld world = test::ApartmentWorld(8.f, 6.f, 0.05f, 4, 5.5f, 4.f);
+  auto planner = MustLoad("greedy");
+  ASSERT_TRUE(planner);
+  const PlanResult r = MustPlan(*planner, world);
+  std::set<uint32_t> tags;
+  std::set<std::pair<float, float>> positions;
+  for (const RobotPlan& plan : r.robots) {
+    ASSERT_EQ(plan.tasks.size(), 1u);  // one task per robot per call
+    EXPECT_TRUE(tags.insert(plan.tasks[0].tag).second);
+    EXPECT_TRUE(
+        positions.insert({plan.tasks[0].position_m.x(), plan.tasks[0].position_m.y()}).second);
+  }
+}
+
+TEST(Planners, GreedyOnIdlePlansOnlyTheIdleRobotAroundOthersQueues) {
+  test::RasterWorld world = test::ApartmentWorld(8.f, 6.f, 0.05f, 2, 5.5f, 4.f);
+  auto planner = MustLoad("greedy");
+  ASSERT_TRUE(planner);
+  // Robot 1 is busy with the view greedy would give it; robot 0 turns idle next to it.
+  const PlanResult start = MustPlan(*planner, world);
+  ASSERT_EQ(start.robots[1].tasks.size(), 1u);
+  world.robots()[1].executing = true;
+  world.robots()[1].queue = start.robots[1].tasks;
+  PlanRequest idle;
+  idle.event = PlanEvent::kRobotIdle;
+  idle.event_robot = 0;
+  const PlanResult r = MustPlan(*planner, world, idle);
+  EXPECT_TRUE(r.robots[1].tasks.empty());
+  EXPECT_EQ(r.robots[1].policy, TaskPolicy::kAppend);  // its queue is left alone
+  ASSERT_EQ(r.robots[0].tasks.size(), 1u);
+  EXPECT_NE(r.robots[0].tasks[0].tag, start.robots[1].tasks[0].tag);
+}
+
+TEST(Planners, BaselinesDoNotRetryAFailedViewAtOnce) {
+  for (const char* name : {"greedy", "voronoi"}) {
+    test::RasterWorld world = SmallApartment();
+    auto planner = MustLoad(name);
+    ASSERT_TRUE(planner);
+    const PlanResult start = MustPlan(*planner, world);
+    ASSERT_EQ(start.robots[1].tasks.size(), 1u) << name;
+    PlanRequest failed;
+    failed.event = PlanEvent::kTaskFailed;
+    failed.event_robot = 1;
+    failed.failed_task = start.robots[1].tasks[0];
+    const PlanResult r = MustPlan(*planner, world, failed);
+    EXPECT_EQ(r.robots[1].tasks.size(), 1u) << name;  // another view of its own
+    for (const PlannerTask& t : r.robots[1].tasks) {
+      EXPECT_NE(t.tag, failed.failed_task.tag) << name;
+      EXPECT_GT((t.position_m - failed.failed_task.position_m).norm(), 0.5f) << name;
+    }
+  }
+}
+
+TEST(Planners, VoronoiSendsEachRobotToViewsNearestToIt) {
+  // Four robots; the two in the rooms next to the unknown part split its views.
+  const test::RasterWorld world = test::ApartmentWorld(10.f, 6.f, 0.05f, 4, 7.f, 3.3f);
+  auto planner = MustLoad("voronoi", R"({"tasks_per_call": 3})");
+  ASSERT_TRUE(planner);
+  const PlanResult r = MustPlan(*planner, world);
+  const std::vector<PlannerRobot> robots = world.Robots();
+  std::vector<std::vector<float>> fields;
+  for (const PlannerRobot& robot : robots) {
+    fields.push_back(world.GeodesicField(robot.position_m, robot.radius_m).value());
+  }
+  const PlannerFloor& floor = world.Floor();
+  int tasks = 0;
+  for (size_t i = 0; i < r.robots.size(); ++i) {
+    EXPECT_LE(r.robots[i].tasks.size(), 3u);
+    for (const PlannerTask& t : r.robots[i].tasks) {
+      ++tasks;
+      const Eigen::Vector2i c = floor.CellOf(t.position_m);
+      const size_t cell = floor.Linear(c.x(), c.y());
+      for (size_t j = 0; j < robots.size(); ++j) {
+        EXPECT_LE(fields[i][cell], fields[j][cell]) << "robot " << i << " vs " << j;
+      }
+    }
+  }
+  EXPECT_GE(tasks, 6);  // two robots own views, and their chains of 3 were followed
+}
+
+}  // namespace
+}  // namespace voxplan
