@@ -1,12 +1,15 @@
 // Micro-benchmarks of the fusion core on frames the simulator renders of the demo room:
 // the block hash map, band allocation, the scalar and SIMD block kernels, whole-frame
-// integration and marching cubes. Run: build/bench/voxplan_microbench [--benchmark_filter=...]
+// integration, marching cubes and ray casting. Run: build/bench/voxplan_microbench
+// [--benchmark_filter=...]
 #include <benchmark/benchmark.h>
 
+#include <algorithm>
 #include <random>
 
 #include "core/block_map.h"
 #include "core/parallel.h"
+#include "core/raycast.h"
 #include "fusion/integrate.h"
 #include "fusion/integrate_kernel.h"
 #include "fusion/mesh_extract.h"
@@ -96,7 +99,8 @@ void BM_BlockKernel(benchmark::State& state) {
   }
   const Frames& f = DemoFrames();
   TsdfVolume volume({0.01f, 0.04f});
-  const auto band = BlocksInTruncationBand(f.images[3].depth, f.camera, f.poses[3], {}, volume.params());
+  const auto band =
+      BlocksInTruncationBand(f.images[3].depth, f.camera, f.poses[3], {}, volume.params());
   std::vector<TsdfBlock*> blocks;
   for (const auto& b : band) blocks.push_back(&volume.FindOrAllocate(b));
   internal::FrameView view;
@@ -155,6 +159,25 @@ void BM_ExtractMesh(benchmark::State& state) {
   state.counters["blocks"] = double(volume.num_blocks());
 }
 BENCHMARK(BM_ExtractMesh)->Args({10, 1})->Args({10, 2})->Unit(benchmark::kMillisecond);
+
+// Ray casting the fused demo room from the demo poses: {voxel mm, threads}. Images are reused,
+// as a tracker or viewer does.
+void BM_RaycastFrame(benchmark::State& state) {
+  const Frames& f = DemoFrames();
+  ThreadLimit limit(int(state.range(1)));
+  const TsdfVolume volume = FusedVolume(float(state.range(0)) / 1000.f);
+  RaycastImages images;
+  size_t i = 0, hits = 0, pixels = 0;
+  for (auto _ : state) {
+    const size_t k = i++ % f.poses.size();
+    Raycast(volume, f.camera, f.poses[k], {}, images);
+    pixels += images.status.data.size();
+    hits += size_t(
+        std::count(images.status.data.begin(), images.status.data.end(), uint8_t(RayStatus::kHit)));
+  }
+  state.counters["hit_fraction"] = pixels ? double(hits) / double(pixels) : 0.0;
+}
+BENCHMARK(BM_RaycastFrame)->Args({10, 1})->Args({10, 2})->Unit(benchmark::kMillisecond);
 
 }  // namespace
 }  // namespace voxplan

@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "core/parallel.h"
+#include "core/raycast_kernels.h"
 
 #if defined(__SSE2__)
 #include <emmintrin.h>
@@ -16,7 +17,7 @@ namespace voxplan {
 namespace {
 
 constexpr int kRangeCell = 8;    // pixels per side of a range-image cell
-constexpr int kSurfaceCell = 4;  // pixels per side of a surface-range cell
+constexpr int kSurfaceCell = 2;  // pixels per side of a surface-range cell
 constexpr int kTile = 16;        // pixels per side of one parallel work item
 constexpr int kLanes = 4;        // rays a worker marches interleaved
 // Step as a fraction of the stored distance: the nearest voxel's centre can be up to 0.87 voxel
@@ -253,71 +254,55 @@ RangeImage BuildRangeImage(const TsdfVolume& volume, const PinholeCamera& camera
   return range;
 }
 
+using raycast_detail::kCornerOffset;
+
 // The 2x2x2 voxel centres around a point, for trilinear interpolation of TSDF, colour and the
 // gradient. Corner k is offset (k & 1, (k >> 1) & 1, k >> 2).
 struct Cell {
-  GlobalVoxelIndex base;
-  bool loaded = false;   // tsdf/block/index hold the corners of `base`
-  uint8_t observed = 0;  // bit k: corner k observed
-  float tsdf[8];         // normalised by the truncation distance
-  const TsdfBlock* block[8];
-  int index[8];
-  Eigen::Vector3f frac;  // position inside the cell, each in [0, 1)
+  alignas(16) int32_t base[4] = {0, 0, 0, 0};        // the corner-0 voxel (x, y, z, 0)
+  alignas(16) float frac[4] = {0.f, 0.f, 0.f, 0.f};  // position inside the cell, each in [0, 1)
+  alignas(16) float tsdf[8];                         // normalised by the truncation distance
+  const TsdfBlock* block[8];  // corner k's block (only block[0] when one_block)
+  int index[8];               // corner k's voxel in it (only index[0] when one_block)
+  bool loaded = false;        // tsdf and the corner addresses hold the corners of `base`
+  bool one_block = false;     // all corners in block[0], at index[0] + kCornerOffset[k]
+  uint8_t observed = 0;       // bit k: corner k observed
 
   bool complete() const { return observed == 0xff; }
-  float Tsdf() const {
-    const float fx = frac.x(), fy = frac.y(), fz = frac.z();
-    const float x00 = tsdf[0] + fx * (tsdf[1] - tsdf[0]);
-    const float x10 = tsdf[2] + fx * (tsdf[3] - tsdf[2]);
-    const float x01 = tsdf[4] + fx * (tsdf[5] - tsdf[4]);
-    const float x11 = tsdf[6] + fx * (tsdf[7] - tsdf[6]);
-    const float y0 = x00 + fy * (x10 - x00), y1 = x01 + fy * (x11 - x01);
-    return y0 + fz * (y1 - y0);
-  }
-  // Gradient of the trilinear interpolant, normalised TSDF per voxel.
-  Eigen::Vector3f Gradient() const {
-    const float* t = tsdf;
-    const float fx = frac.x(), fy = frac.y(), fz = frac.z();
-    return {(1 - fy) * (1 - fz) * (t[1] - t[0]) + fy * (1 - fz) * (t[3] - t[2]) +
-                (1 - fy) * fz * (t[5] - t[4]) + fy * fz * (t[7] - t[6]),
-            (1 - fx) * (1 - fz) * (t[2] - t[0]) + fx * (1 - fz) * (t[3] - t[1]) +
-                (1 - fx) * fz * (t[6] - t[4]) + fx * fz * (t[7] - t[5]),
-            (1 - fx) * (1 - fy) * (t[4] - t[0]) + fx * (1 - fy) * (t[5] - t[1]) +
-                (1 - fx) * fy * (t[6] - t[2]) + fx * fy * (t[7] - t[3])};
+  const TsdfBlock& CornerBlock(int k) const { return *block[one_block ? 0 : k]; }
+  int CornerIndex(int k) const { return one_block ? index[0] + kCornerOffset[k] : index[k]; }
+  // The trilinear interpolant at frac and its gradient (normalised TSDF per voxel).
+  float ValueAndGradient(Eigen::Vector3f* gradient) const {
+    return raycast_detail::ValueAndGradient(tsdf, frac, gradient->data());
   }
 };
 
-// Block lookups for one worker: the last block, then a small direct-mapped cache (misses
-// included) in front of the hash map, since neighbouring rays visit the same blocks.
+// Block lookups for one worker: a small direct-mapped cache (misses included) in front of the
+// hash map, since neighbouring rays visit the same blocks.
 class BlockCache {
  public:
   explicit BlockCache(const TsdfVolume& volume) : volume_(volume) {}
 
   const TsdfBlock* Find(BlockIndex b) {
-    if (b == last_index_ && last_valid_) return last_block_;
-    last_index_ = b;
-    last_valid_ = true;
-    if (!InPackRange(b)) return last_block_ = nullptr;
-    const uint64_t key = PackBlockIndex(b);
-    Entry& e = entries_[(key * 0x9e3779b97f4a7c15ull) >> (64 - kCacheBits)];
-    if (e.key != key) {
-      e.key = key;
-      e.block = volume_.FindBlock(b);
+    const uint32_t hash =
+        uint32_t(b.x) * 0x8da6b343u ^ uint32_t(b.y) * 0xd8163841u ^ uint32_t(b.z) * 0xcb1ab31fu;
+    Entry& e = entries_[hash >> (32 - kCacheBits)];
+    if (!(e.index == b)) {
+      e.index = b;
+      // Indices beyond the packable range would alias in the hash map; none is allocated.
+      e.block = InPackRange(b) ? volume_.FindBlock(b) : nullptr;
     }
-    return last_block_ = e.block;
+    return e.block;
   }
 
  private:
   static constexpr int kCacheBits = 8;
   struct Entry {
-    uint64_t key = ~0ull;  // never a packed index (those use 63 bits)
+    BlockIndex index{kMaxBlockCoord + 1, 0, 0};  // out of range: no block, correctly
     const TsdfBlock* block = nullptr;
   };
   const TsdfVolume& volume_;
   Entry entries_[1 << kCacheBits];
-  BlockIndex last_index_{};
-  const TsdfBlock* last_block_ = nullptr;
-  bool last_valid_ = false;
 };
 
 class Sampler {
@@ -331,7 +316,15 @@ class Sampler {
         min_weight_fixed_(
             uint32_t(std::clamp(std::ceil(params.min_weight * kWeightScale), 1.f, 65536.f))) {}
 
-  const TsdfBlock* Find(BlockIndex b) { return cache_.Find(b); }
+  // The last block looked up (by the march or a gather) first: a refinement mostly reads the
+  // block the march just sampled.
+  const TsdfBlock* Find(BlockIndex b) {
+    if (!(b == last_index_)) {
+      last_index_ = b;
+      last_block_ = cache_.Find(b);
+    }
+    return last_block_;
+  }
   bool Observed(const TsdfBlock& block, int i) const {
     return uint32_t(block.weight[i]) >= min_weight_fixed_;
   }
@@ -340,29 +333,71 @@ class Sampler {
   // corners take the interpolation-weighted mean of the observed ones; returns whether all
   // eight were observed.
   bool Gather(const Eigen::Vector3f& p_W, Cell* cell) {
+    // The cell's corner 0 and the position inside it, in voxel units.
+#if VOXPLAN_RAYCAST_SSE2
+    const __m128 q =
+        _mm_sub_ps(_mm_mul_ps(_mm_set_ps(0.f, p_W.z(), p_W.y(), p_W.x()), _mm_set1_ps(inv_voxel_)),
+                   _mm_set_ps(0.f, 0.5f, 0.5f, 0.5f));
+    const __m128i truncated = _mm_cvttps_epi32(q);
+    const __m128 truncated_f = _mm_cvtepi32_ps(truncated);
+    const __m128i base = _mm_add_epi32(truncated, _mm_castps_si128(_mm_cmplt_ps(q, truncated_f)));
+    _mm_store_ps(cell->frac, _mm_sub_ps(q, _mm_cvtepi32_ps(base)));
+    const __m128i old_base = _mm_load_si128(reinterpret_cast<const __m128i*>(cell->base));
+    if (cell->loaded && _mm_movemask_epi8(_mm_cmpeq_epi32(base, old_base)) == 0xffff)
+      return cell->complete();
+    _mm_store_si128(reinterpret_cast<__m128i*>(cell->base), base);
+#else
     const Eigen::Vector3f q = p_W * inv_voxel_ - Eigen::Vector3f::Constant(0.5f);
-    const GlobalVoxelIndex base{FloorToInt(q.x()), FloorToInt(q.y()), FloorToInt(q.z())};
-    cell->frac = q - Eigen::Vector3f(float(base.x), float(base.y), float(base.z));
-    if (cell->loaded && cell->base == base) return cell->complete();
-    cell->base = base;
+    const int32_t base[3] = {FloorToInt(q.x()), FloorToInt(q.y()), FloorToInt(q.z())};
+    for (int a = 0; a < 3; ++a) cell->frac[a] = q[a] - float(base[a]);
+    if (cell->loaded && base[0] == cell->base[0] && base[1] == cell->base[1] &&
+        base[2] == cell->base[2])
+      return cell->complete();
+    for (int a = 0; a < 3; ++a) cell->base[a] = base[a];
+#endif
     cell->loaded = true;
-    cell->observed = 0;
-    const VoxelIndex local = LocalOf(base);
+    const GlobalVoxelIndex g{cell->base[0], cell->base[1], cell->base[2]};
+    const VoxelIndex local = LocalOf(g);
+    const BlockIndex b0 = BlockOf(g);
+    unsigned observed = 0;
     if (local.x < kBlockMask && local.y < kBlockMask && local.z < kBlockMask) {
-      // The common case: all eight corners in one block.
-      const TsdfBlock* block = Find(BlockOf(base));
+      // The common case: all eight corners in one block, at fixed offsets.
+      const TsdfBlock* block = Find(b0);
       const int i0 = LinearIndex(local);
-      for (int k = 0; k < 8; ++k) {
-        const int i =
-            i0 + (k & 1) + ((k >> 1) & 1) * kBlockSide + (k >> 2) * kBlockSide * kBlockSide;
-        Load(block, i, k, cell);
-      }
+      cell->one_block = true;
+      cell->block[0] = block;
+      cell->index[0] = i0;
+      if (block) observed = raycast_detail::LoadCorners(*block, i0, min_weight_fixed_, cell->tsdf);
     } else {
+      // Corners across block faces: look up only the neighbours they reach (two usually).
+      const bool ex = local.x == kBlockMask, ey = local.y == kBlockMask, ez = local.z == kBlockMask;
+      const TsdfBlock* neighbour[8] = {};
+      neighbour[0] = Find(b0);
+      if (ex) neighbour[1] = Find(BlockIndex{b0.x + 1, b0.y, b0.z});
+      if (ey) neighbour[2] = Find(BlockIndex{b0.x, b0.y + 1, b0.z});
+      if (ex && ey) neighbour[3] = Find(BlockIndex{b0.x + 1, b0.y + 1, b0.z});
+      if (ez) {
+        neighbour[4] = Find(BlockIndex{b0.x, b0.y, b0.z + 1});
+        if (ex) neighbour[5] = Find(BlockIndex{b0.x + 1, b0.y, b0.z + 1});
+        if (ey) neighbour[6] = Find(BlockIndex{b0.x, b0.y + 1, b0.z + 1});
+        if (ex && ey) neighbour[7] = Find(BlockIndex{b0.x + 1, b0.y + 1, b0.z + 1});
+      }
+      cell->one_block = false;
       for (int k = 0; k < 8; ++k) {
-        const GlobalVoxelIndex g{base.x + (k & 1), base.y + ((k >> 1) & 1), base.z + (k >> 2)};
-        Load(Find(BlockOf(g)), LinearIndex(LocalOf(g)), k, cell);
+        const int cx = k & 1, cy = (k >> 1) & 1, cz = k >> 2;
+        const TsdfBlock* block =
+            neighbour[(cx & int(ex)) | ((cy & int(ey)) << 1) | ((cz & int(ez)) << 2)];
+        const int i = LinearIndex((local.x + cx) & kBlockMask, (local.y + cy) & kBlockMask,
+                                  (local.z + cz) & kBlockMask);
+        cell->block[k] = block;
+        cell->index[k] = i;
+        if (block && Observed(*block, i)) {
+          cell->tsdf[k] = DecodeTsdf(block->tsdf[i]);
+          observed |= 1u << k;
+        }
       }
     }
+    cell->observed = uint8_t(observed);
     if (cell->complete()) return true;
     float sum = 0.f, sum_w = 0.f;
     for (int k = 0; k < 8; ++k)
@@ -378,26 +413,11 @@ class Sampler {
   float trunc_m() const { return trunc_m_; }
 
  private:
-  void Load(const TsdfBlock* block, int i, int k, Cell* cell) const {
-    cell->block[k] = block;
-    cell->index[k] = i;
-    if (block && Observed(*block, i)) {
-      cell->tsdf[k] = DecodeTsdf(block->tsdf[i]);
-      cell->observed |= uint8_t(1 << k);
-    }
-  }
-
   BlockCache cache_;
+  BlockIndex last_index_{kMaxBlockCoord + 1, 0, 0};
+  const TsdfBlock* last_block_ = nullptr;
   float voxel_m_, inv_voxel_, trunc_m_;
   uint32_t min_weight_fixed_;
-};
-
-// A pixel whose ray has a depth range to march.
-struct RayTask {
-  size_t pixel;
-  int u, v;
-  float z_begin, z_end;
-  float z_restart;  // >= 0: on a miss, march again from here
 };
 
 struct RayResult {
@@ -409,14 +429,24 @@ struct RayResult {
 
 // Trilinear colour over the observed corners.
 uint32_t CellColor(const Cell& cell) {
-  const float fx = cell.frac.x(), fy = cell.frac.y(), fz = cell.frac.z();
+  if (cell.complete()) {
+    if (cell.one_block) return raycast_detail::BlendColor(*cell.block[0], cell.index[0], cell.frac);
+    uint8_t r[8], g[8], b[8];
+    for (int k = 0; k < 8; ++k) {
+      r[k] = cell.block[k]->r[cell.index[k]];
+      g[k] = cell.block[k]->g[cell.index[k]];
+      b[k] = cell.block[k]->b[cell.index[k]];
+    }
+    return raycast_detail::BlendCornerColors(r, g, b, cell.frac);
+  }
+  const float fx = cell.frac[0], fy = cell.frac[1], fz = cell.frac[2];
   float r = 0.f, g = 0.f, b = 0.f, sum_w = 0.f;
   for (int k = 0; k < 8; ++k) {
     if (!(cell.observed & (1 << k))) continue;
     const float w =
         ((k & 1) ? fx : 1 - fx) * (((k >> 1) & 1) ? fy : 1 - fy) * ((k >> 2) ? fz : 1 - fz);
-    const TsdfBlock& block = *cell.block[k];
-    const int i = cell.index[k];
+    const TsdfBlock& block = cell.CornerBlock(k);
+    const int i = cell.CornerIndex(k);
     r += w * float(block.r[i]);
     g += w * float(block.g[i]);
     b += w * float(block.b[i]);
@@ -432,12 +462,17 @@ uint32_t CellColor(const Cell& cell) {
 // and overlap their memory latency. The ray is p(z) = origin + z * dir_W, with dir_W the
 // camera ray scaled to unit optical depth, so z is the depth itself.
 struct Ray {
+#if VOXPLAN_RAYCAST_SSE2
+  __m128 dir_vox;       // the ray in voxel units, lanes (x, y, z, 0)
+  __m128i block_lanes;  // block_index in lanes (x, y, z, 0)
+#else
+  Eigen::Vector3f dir_vox;  // the ray in voxel units: p = origin_vox + z * dir_vox
+#endif
   Eigen::Vector3f dir_W;
   float z = 0.f, z_end = 0.f;
   float voxel_z = 0.f;       // one voxel along the ray, in depth units
   float step_scale_z = 0.f;  // stored fixed-point TSDF to a step in depth units
   bool have_prev = false;    // previous sample observed, nothing unobserved since
-  Eigen::Vector3f dir_vox;   // the ray in voxel units: p = origin_vox + z * dir_vox
   BlockIndex block_index{kMaxBlockCoord + 1, 0, 0};  // the last block this ray sampled
   const TsdfBlock* block = nullptr;
   float prev_z = 0.f;
@@ -447,6 +482,14 @@ struct Ray {
   RayResult result;
 };
 
+// A pixel whose ray has a depth range to march.
+struct RayTask {
+  size_t pixel;
+  int u, v;
+  float z_begin, z_end;
+  float z_restart;  // >= 0: on a miss, march again from here
+};
+
 class RayCaster {
  public:
   RayCaster(const TsdfVolume& volume, const RaycastParams& params, const Eigen::Vector3f& origin_W)
@@ -454,8 +497,13 @@ class RayCaster {
         params_(params),
         origin_W_(origin_W),
         origin_vox_(origin_W * sampler_.inv_voxel()),
-        step_scale_(kStepScale * volume.trunc_m() / kTsdfScale) {}
+        step_scale_(kStepScale * volume.trunc_m() / kTsdfScale) {
+#if VOXPLAN_RAYCAST_SSE2
+    origin_vox_lanes_ = _mm_set_ps(0.f, origin_vox_.z(), origin_vox_.y(), origin_vox_.x());
+#endif
+  }
 
+  // Starts marching the ray p(z) = origin + z * dir_W from z_begin to z_end.
   void Start(const Eigen::Vector3f& dir_W, float z_begin, float z_end, Ray* ray) const {
     const float inv_norm = 1.f / std::sqrt(dir_W.squaredNorm());
     ray->dir_W = dir_W;
@@ -464,26 +512,50 @@ class RayCaster {
     ray->voxel_z = sampler_.voxel_m() * inv_norm;
     ray->step_scale_z = step_scale_ * inv_norm;
     ray->have_prev = false;
-    ray->dir_vox = dir_W * sampler_.inv_voxel();
     ray->block_index = BlockIndex{kMaxBlockCoord + 1, 0, 0};
+    ray->block = nullptr;
     ray->result = RayResult{};
+#if VOXPLAN_RAYCAST_SSE2
+    const Eigen::Vector3f dir_vox = dir_W * sampler_.inv_voxel();
+    ray->dir_vox = _mm_set_ps(0.f, dir_vox.z(), dir_vox.y(), dir_vox.x());
+    ray->block_lanes = _mm_set_epi32(0, 0, 0, ray->block_index.x);
+#else
+    ray->dir_vox = dir_W * sampler_.inv_voxel();
+#endif
   }
 
-  // Takes one sample; true when the ray is finished and ray->result final.
+  // Takes one sample of the nearest voxel; true when the ray is finished and ray.result final.
+  // A sign change from positive to negative is refined on the trilinear interpolant.
   bool Step(Ray& ray) {
     if (!(ray.z <= ray.z_end)) return true;
+#if VOXPLAN_RAYCAST_SSE2
+    // The sample's voxel in SSE2 lanes (x, y, z, 0): the same products, sums and floors.
+    const __m128 p = _mm_add_ps(origin_vox_lanes_, _mm_mul_ps(_mm_set1_ps(ray.z), ray.dir_vox));
+    const __m128i truncated = _mm_cvttps_epi32(p);
+    const __m128i g =
+        _mm_add_epi32(truncated, _mm_castps_si128(_mm_cmplt_ps(p, _mm_cvtepi32_ps(truncated))));
+    const __m128i b_lanes = _mm_srai_epi32(g, kBlockShift);
+    // Each ray keeps its own last block: interleaved rays would evict a shared one.
+    if (_mm_movemask_epi8(_mm_cmpeq_epi32(b_lanes, ray.block_lanes)) != 0xffff) {
+      ray.block_lanes = b_lanes;
+      alignas(16) int32_t v[4];
+      _mm_store_si128(reinterpret_cast<__m128i*>(v), b_lanes);
+      ray.block_index = BlockIndex{v[0], v[1], v[2]};
+      ray.block = sampler_.Find(ray.block_index);
+    }
+#else
     const Eigen::Vector3f p = origin_vox_ + ray.z * ray.dir_vox;
     const GlobalVoxelIndex g{FloorToInt(p.x()), FloorToInt(p.y()), FloorToInt(p.z())};
-    const BlockIndex b = BlockOf(g);
-    // Each ray keeps its own last block: interleaved rays would evict a shared one.
-    if (!(b == ray.block_index)) {
-      ray.block_index = b;
-      ray.block = sampler_.Find(b);
+    if (!(BlockOf(g) == ray.block_index)) {
+      ray.block_index = BlockOf(g);
+      ray.block = sampler_.Find(ray.block_index);
     }
+#endif
     const TsdfBlock* block = ray.block;
     if (!block) {
       // Jump to where the ray leaves this unallocated block (nudged past the face).
       const float block_m = sampler_.voxel_m() * kBlockSide;
+      const BlockIndex& b = ray.block_index;
       float z_exit = std::numeric_limits<float>::infinity();
       for (int a = 0; a < 3; ++a) {
         const float d = ray.dir_W[a];
@@ -495,7 +567,15 @@ class RayCaster {
       ray.have_prev = false;
       return false;
     }
+#if VOXPLAN_RAYCAST_SSE2
+    // LinearIndex as a multiply-add of 16-bit halves (the high halves are zero).
+    const __m128i terms = _mm_madd_epi16(_mm_and_si128(g, _mm_set1_epi32(kBlockMask)),
+                                         _mm_set_epi32(0, kBlockSide * kBlockSide, kBlockSide, 1));
+    const __m128i pairs = _mm_add_epi32(terms, _mm_srli_si128(terms, 8));
+    const int i = _mm_cvtsi128_si32(_mm_add_epi32(pairs, _mm_srli_si128(pairs, 4)));
+#else
     const int i = LinearIndex(LocalOf(g));
+#endif
     if (!sampler_.Observed(*block, i)) {
       ray.z += ray.voxel_z;
       ray.have_prev = false;
@@ -528,9 +608,10 @@ class RayCaster {
   }
 
  private:
-  bool Sample(const Eigen::Vector3f& dir_W, float z, Cell* cell, float* tsdf) {
+  bool Sample(const Eigen::Vector3f& dir_W, float z, Cell* cell, float* tsdf,
+              Eigen::Vector3f* gradient) {
     const bool complete = sampler_.Gather(origin_W_ + z * dir_W, cell);
-    *tsdf = cell->Tsdf();
+    *tsdf = cell->ValueAndGradient(gradient);
     return complete;
   }
 
@@ -552,8 +633,7 @@ class RayCaster {
     bool converged = false;
     for (int k = 0; k < kNewtonIterations; ++k) {
       float f = 0.f;
-      if (!Sample(dir_W, z, &cell, &f)) break;
-      gradient = cell.Gradient();
+      if (!Sample(dir_W, z, &cell, &f, &gradient)) break;
       const float slope = gradient.dot(dir_W) * dq_dz;  // per metre of z
       if (!(slope * voxel_z < max_slope)) break;
       const float dz = -f / slope;
@@ -572,8 +652,7 @@ class RayCaster {
         z = z_guess;
       }
       float f = 0.f;
-      Sample(dir_W, z, &cell, &f);  // the cell at the final point
-      gradient = cell.Gradient();
+      Sample(dir_W, z, &cell, &f, &gradient);  // the cell at the final point
     }
     result->status = RayStatus::kHit;
     result->z = z;
@@ -591,22 +670,24 @@ class RayCaster {
   bool Bracket(const Eigen::Vector3f& dir_W, float z_a, float z_b, float voxel_z, Cell* cell,
                float* z_out) {
     float f_a = 0.f, f_b = 0.f;
-    if (!Sample(dir_W, z_a, cell, &f_a) || !Sample(dir_W, z_b, cell, &f_b)) return false;
+    Eigen::Vector3f gradient;  // unused here
+    auto sample = [&](float z, float* f) { return Sample(dir_W, z, cell, f, &gradient); };
+    if (!sample(z_a, &f_a) || !sample(z_b, &f_b)) return false;
     for (int k = 0; f_a < 0.f && k < kMaxBracketShifts; ++k) {
       z_b = z_a, f_b = f_a;
       z_a -= voxel_z;
-      if (!Sample(dir_W, z_a, cell, &f_a)) return false;
+      if (!sample(z_a, &f_a)) return false;
     }
     for (int k = 0; f_b >= 0.f && k < kMaxBracketShifts; ++k) {
       z_a = z_b, f_a = f_b;
       z_b += voxel_z;
-      if (!Sample(dir_W, z_b, cell, &f_b)) return false;
+      if (!sample(z_b, &f_b)) return false;
     }
     if (!(f_a >= 0.f && f_b < 0.f)) return false;
     for (int k = 0; k < kSecantIterations; ++k) {
       const float z = z_a + (z_b - z_a) * f_a / (f_a - f_b);
       float f = 0.f;
-      if (!Sample(dir_W, z, cell, &f)) break;
+      if (!sample(z, &f)) break;
       if (f >= 0.f)
         z_a = z, f_a = f;
       else
@@ -619,6 +700,9 @@ class RayCaster {
   Sampler sampler_;
   RaycastParams params_;
   Eigen::Vector3f origin_W_, origin_vox_;
+#if VOXPLAN_RAYCAST_SSE2
+  __m128 origin_vox_lanes_;
+#endif
   float step_scale_;  // stored fixed-point TSDF to a step in metres along the ray
 };
 
@@ -652,7 +736,9 @@ void Raycast(const TsdfVolume& volume, const PinholeCamera& camera, const Pose3f
   // The ray through pixel (u, v), scaled to unit optical depth: d0 + u du + v dv.
   const Eigen::Vector3f du_W = R_W_C.col(0) / camera.fx, dv_W = R_W_C.col(1) / camera.fy;
   const Eigen::Vector3f d0_W = R_W_C.col(2) - camera.cx * du_W - camera.cy * dv_W;
-  const float surface_margin = 2.f * volume.voxel_size_m();
+  // surface_z_min already bounds every negative voxel's cube, so the first sample in front of
+  // it is never negative; half a voxel more absorbs rounding, and more only adds steps.
+  const float surface_margin = 0.5f * volume.voxel_size_m();
   const int tiles_x = (w + kTile - 1) / kTile, tiles_y = (h + kTile - 1) / kTile;
 
   auto write = [&](size_t px, const RayResult& ray, const Eigen::Vector3f& dir_W) {
@@ -672,6 +758,7 @@ void Raycast(const TsdfVolume& volume, const PinholeCamera& camera, const Pose3f
 
   ParallelFor(size_t(tiles_x) * size_t(tiles_y), 4, [&](size_t begin, size_t end) {
     RayCaster caster(volume, params, origin_W);
+    const RayResult unobserved;
     for (size_t tile = begin; tile < end; ++tile) {
       const int u0 = int(tile % size_t(tiles_x)) * kTile, v0 = int(tile / size_t(tiles_x)) * kTile;
       const int u_end = std::min(u0 + kTile, w), v_end = std::min(v0 + kTile, h);
@@ -689,8 +776,8 @@ void Raycast(const TsdfVolume& volume, const PinholeCamera& camera, const Pose3f
             const float z_all = std::max(range.z_min[cell], z_start);
             const float z_end = std::min(range.z_max[cell], params.max_depth_m);
             if (z_all <= z_end) {
-              // Start two voxels in front of the nearest block that can end a crossing, so
-              // the sample before the crossing is still taken.
+              // Start just in front of the nearest cube of a negative voxel: no crossing can
+              // end before it.
               const float z_surface = std::max(
                   range.surface_z_min[surface_row + size_t(u / kSurfaceCell)] - surface_margin,
                   z_all);
@@ -699,11 +786,7 @@ void Raycast(const TsdfVolume& volume, const PinholeCamera& camera, const Pose3f
               continue;
             }
           }
-          images.status.data[px] = uint8_t(RayStatus::kUnobserved);
-          images.depth.data[px] = 0.f;
-          images.vertex_W.data[px] = nan3;
-          images.normal_W.data[px] = nan3;
-          images.color.data[px] = 0;
+          write(px, unobserved, d0_W);
         }
       }
       int next = 0;
@@ -726,7 +809,8 @@ void Raycast(const TsdfVolume& volume, const PinholeCamera& camera, const Pose3f
           if (rays[l].result.status != RayStatus::kHit && rays[l].z_restart >= 0.f) {
             // A miss after skipping free space: march the whole range, so the status says
             // whether the ray met observed space.
-            caster.Start(rays[l].dir_W, rays[l].z_restart, rays[l].z_end, &rays[l]);
+            const float z_restart = rays[l].z_restart;
+            caster.Start(rays[l].dir_W, z_restart, rays[l].z_end, &rays[l]);
             rays[l].z_restart = -1.f;
             continue;
           }

@@ -7,10 +7,12 @@
 #include <cstdio>
 #include <cstring>
 #include <functional>
+#include <random>
 #include <vector>
 
 #include "core/parallel.h"
 #include "core/raycast.h"
+#include "core/raycast_kernels.h"
 #include "tests/support/test_support.h"
 
 namespace voxplan {
@@ -373,6 +375,147 @@ TEST(Raycast, InvalidInputsGiveEmptyOrUnobservedImages) {
   nan_pose.translation().x() = std::numeric_limits<float>::quiet_NaN();
   const RaycastImages images = Raycast(volume, TestCamera(80, 60), nan_pose);
   EXPECT_EQ(Count(images, RayStatus::kUnobserved), images.status.data.size());
+}
+
+// The caster's SSE2 kernels against their scalar references (core/raycast_kernels.h).
+namespace kernels = raycast_detail;
+
+TsdfBlock RandomBlock(std::mt19937& rng) {
+  TsdfBlock block;
+  std::uniform_int_distribution<int> tsdf(-32767, 32767), weight(0, 65535), colour(0, 255);
+  for (int i = 0; i < kBlockVoxels; ++i) {
+    block.tsdf[i] = int16_t(tsdf(rng));
+    block.weight[i] = uint16_t(i % 7 == 0 ? 0 : weight(rng));  // some never observed
+    block.r[i] = uint8_t(colour(rng));
+    block.g[i] = uint8_t(colour(rng));
+    block.b[i] = uint8_t(colour(rng));
+  }
+  return block;
+}
+
+// Every cell base inside a block (local coordinates < 7 on each axis).
+std::vector<int> InnerCellBases() {
+  std::vector<int> bases;
+  for (int z = 0; z < kBlockMask; ++z)
+    for (int y = 0; y < kBlockMask; ++y)
+      for (int x = 0; x < kBlockMask; ++x) bases.push_back(LinearIndex(x, y, z));
+  return bases;
+}
+
+TEST(RaycastKernels, CornerLoadsMatchTheScalarReferenceExactly) {
+#if !VOXPLAN_RAYCAST_SSE2
+  GTEST_SKIP() << "no SSE2 kernels in this build";
+#else
+  std::mt19937 rng(7);
+  const TsdfBlock block = RandomBlock(rng);
+  for (const uint32_t min_weight : {1u, 64u, 32768u, 65535u, 65536u})
+    for (const int i0 : InnerCellBases()) {
+      float scalar[8], simd[8];
+      const uint8_t observed = kernels::LoadCornersScalar(block, i0, min_weight, scalar);
+      ASSERT_EQ(kernels::LoadCornersSse2(block, i0, min_weight, simd), observed) << i0;
+      for (int k = 0; k < 8; ++k) {
+        ASSERT_EQ(simd[k], scalar[k]) << i0 << " corner " << k;
+        // Corner k is voxel base + (k & 1, (k >> 1) & 1, k >> 2).
+        const int i =
+            i0 + (k & 1) + ((k >> 1) & 1) * kBlockSide + (k >> 2) * kBlockSide * kBlockSide;
+        EXPECT_EQ(scalar[k], DecodeTsdf(block.tsdf[i]));
+        EXPECT_EQ(bool(observed & (1 << k)), block.weight[i] >= min_weight);
+      }
+    }
+#endif
+}
+
+// Rounding of 4-term sums of values in [-1, 1] taken in another order.
+constexpr float kSumRounding = 1e-6f;
+
+TEST(RaycastKernels, TrilinearValueAndGradientAreExactOnALinearFunction) {
+  // f = a + g . (corner offset): the interpolant is f itself and its gradient g everywhere.
+  const float a = 0.125f;
+  const Eigen::Vector3f g(0.25f, -0.375f, 0.0625f);
+  float t[8];
+  for (int k = 0; k < 8; ++k)
+    t[k] = a + g.x() * float(k & 1) + g.y() * float((k >> 1) & 1) + g.z() * float(k >> 2);
+  std::mt19937 rng(3);
+  std::uniform_real_distribution<float> unit(0.f, 1.f);
+  for (int n = 0; n < 200; ++n) {
+    const float frac[4] = {unit(rng), unit(rng), unit(rng), 0.f};
+    const float expected = a + g.x() * frac[0] + g.y() * frac[1] + g.z() * frac[2];
+    float gradient[3];
+    EXPECT_NEAR(kernels::ValueAndGradientScalar(t, frac, gradient), expected, kSumRounding);
+    for (int i = 0; i < 3; ++i) EXPECT_NEAR(gradient[i], g[i], kSumRounding);
+#if VOXPLAN_RAYCAST_SSE2
+    EXPECT_NEAR(kernels::ValueAndGradientSse2(t, frac, gradient), expected, kSumRounding);
+    for (int i = 0; i < 3; ++i) EXPECT_NEAR(gradient[i], g[i], kSumRounding);
+#endif
+  }
+}
+
+TEST(RaycastKernels, ValueAndGradientMatchTheScalarReference) {
+#if !VOXPLAN_RAYCAST_SSE2
+  GTEST_SKIP() << "no SSE2 kernels in this build";
+#else
+  std::mt19937 rng(5);
+  std::uniform_real_distribution<float> unit(0.f, 1.f), value(-1.f, 1.f);
+  for (int n = 0; n < 2000; ++n) {
+    float t[8];
+    for (float& v : t) v = value(rng);
+    // Corners and faces too: frac exactly 0 or 1.
+    const float frac[4] = {n % 5 == 0 ? 0.f : unit(rng), n % 7 == 0 ? 1.f : unit(rng), unit(rng),
+                           0.f};
+    float scalar_gradient[3], simd_gradient[3];
+    const float scalar = kernels::ValueAndGradientScalar(t, frac, scalar_gradient);
+    EXPECT_NEAR(kernels::ValueAndGradientSse2(t, frac, simd_gradient), scalar, kSumRounding);
+    for (int i = 0; i < 3; ++i) EXPECT_NEAR(simd_gradient[i], scalar_gradient[i], kSumRounding);
+  }
+#endif
+}
+
+// Colour channels are rounded to integers after a weighted mean summed in another order.
+constexpr int kColourRoundingLevels = 1;
+
+TEST(RaycastKernels, ColourBlendsMatchTheScalarReference) {
+#if !VOXPLAN_RAYCAST_SSE2
+  GTEST_SKIP() << "no SSE2 kernels in this build";
+#else
+  std::mt19937 rng(11);
+  const TsdfBlock block = RandomBlock(rng);
+  std::uniform_real_distribution<float> unit(0.f, 1.f);
+  size_t checked = 0, identical = 0;
+  auto near = [](uint32_t a, uint32_t b) {
+    for (int shift = 0; shift < 24; shift += 8)
+      if (std::abs(int((a >> shift) & 255) - int((b >> shift) & 255)) > kColourRoundingLevels)
+        return false;
+    return (a >> 24) == 0 && (b >> 24) == 0;
+  };
+  for (const int i0 : InnerCellBases())
+    for (int n = 0; n < 4; ++n) {
+      const float frac[4] = {unit(rng), unit(rng), unit(rng), 0.f};
+      const uint32_t scalar = kernels::BlendColorScalar(block, i0, frac);
+      const uint32_t simd = kernels::BlendColorSse2(block, i0, frac);
+      EXPECT_TRUE(near(simd, scalar)) << i0 << ": " << simd << " vs " << scalar;
+      // The same corners given as arrays.
+      uint8_t r[8], g[8], b[8];
+      for (int k = 0; k < 8; ++k) {
+        r[k] = block.r[i0 + kernels::kCornerOffset[k]];
+        g[k] = block.g[i0 + kernels::kCornerOffset[k]];
+        b[k] = block.b[i0 + kernels::kCornerOffset[k]];
+      }
+      EXPECT_EQ(kernels::BlendCornerColorsScalar(r, g, b, frac), scalar);
+      EXPECT_EQ(kernels::BlendCornerColorsSse2(r, g, b, frac), simd);
+      ++checked;
+      identical += simd == scalar;
+    }
+  // Off by one only where a channel's mean lies within rounding of a half.
+  EXPECT_GT(identical, checked * 95 / 100);
+  // A uniform colour blends to itself at any position.
+  TsdfBlock uniform = block;
+  std::fill(std::begin(uniform.r), std::end(uniform.r), uint8_t(200));
+  std::fill(std::begin(uniform.g), std::end(uniform.g), uint8_t(13));
+  std::fill(std::begin(uniform.b), std::end(uniform.b), uint8_t(255));
+  const float frac[4] = {0.3f, 0.9f, 0.5f, 0.f};
+  EXPECT_EQ(kernels::BlendColorSse2(uniform, LinearIndex(2, 3, 4), frac), PackRgb(200, 13, 255));
+  EXPECT_EQ(kernels::BlendColorScalar(uniform, LinearIndex(2, 3, 4), frac), PackRgb(200, 13, 255));
+#endif
 }
 
 }  // namespace
