@@ -477,22 +477,46 @@ std::vector<GlobalVoxelIndex> PlanningMap::FrontierVoxels() const {
   return out;
 }
 
+PlanningMap::Neighbourhood PlanningMap::NeighbourhoodOf(BlockIndex b) const {
+  Neighbourhood n;
+  n.self = volume_->FindBlock(b);
+  for (int k = 0; k < 6; ++k) n.faces[k] = volume_->FindBlock(Neighbour(b, k));
+  return n;
+}
+
 Eigen::Vector3f PlanningMap::NormalAt(GlobalVoxelIndex g) const {
+  return NormalIn(NeighbourhoodOf(BlockOf(g)), LocalOf(g));
+}
+
+Eigen::Vector3f PlanningMap::NormalIn(const Neighbourhood& n, VoxelIndex v) const {
   // TSDF at a voxel, when observed; central differences, one-sided next to unobserved voxels.
-  auto tsdf = [&](GlobalVoxelIndex q) -> std::optional<float> {
-    const TsdfBlock* b = volume_->FindBlock(BlockOf(q));
+  // A difference steps along one axis at a time, so only face neighbours are ever read.
+  auto tsdf = [&](int x, int y, int z) -> std::optional<float> {
+    const TsdfBlock* b = n.self;
+    if (x < 0) {
+      b = n.faces[0], x += kBlockSide;
+    } else if (x >= kBlockSide) {
+      b = n.faces[1], x -= kBlockSide;
+    } else if (y < 0) {
+      b = n.faces[2], y += kBlockSide;
+    } else if (y >= kBlockSide) {
+      b = n.faces[3], y -= kBlockSide;
+    } else if (z < 0) {
+      b = n.faces[4], z += kBlockSide;
+    } else if (z >= kBlockSide) {
+      b = n.faces[5], z -= kBlockSide;
+    }
     if (!b) return std::nullopt;
-    const int i = LinearIndex(LocalOf(q));
+    const int i = LinearIndex(x, y, z);
     if (!Observed(*b, i)) return std::nullopt;
     return DecodeTsdf(b->tsdf[i]);
   };
-  const std::optional<float> c = tsdf(g);
+  const std::optional<float> c = tsdf(v.x, v.y, v.z);
   Eigen::Vector3f grad = Eigen::Vector3f::Zero();
   for (int k = 0; k < 3; ++k) {
-    GlobalVoxelIndex lo = g, hi = g;
-    (k == 0 ? lo.x : k == 1 ? lo.y : lo.z) -= 1;
-    (k == 0 ? hi.x : k == 1 ? hi.y : hi.z) += 1;
-    const std::optional<float> m = tsdf(lo), p = tsdf(hi);
+    const int dx = k == 0, dy = k == 1, dz = k == 2;
+    const std::optional<float> m = tsdf(v.x - dx, v.y - dy, v.z - dz);
+    const std::optional<float> p = tsdf(v.x + dx, v.y + dy, v.z + dz);
     if (m && p) {
       grad[k] = 0.5f * (*p - *m);
     } else if (p && c) {
@@ -501,37 +525,65 @@ Eigen::Vector3f PlanningMap::NormalAt(GlobalVoxelIndex g) const {
       grad[k] = *c - *m;
     }
   }
-  const float n = grad.norm();
-  return n > 0.f ? Eigen::Vector3f(grad / n) : Eigen::Vector3f::Zero();
+  const float norm = grad.norm();
+  return norm > 0.f ? Eigen::Vector3f(grad / norm) : Eigen::Vector3f::Zero();
 }
 
-std::vector<SurfaceVoxel> PlanningMap::SurfaceVoxels() const {
-  std::vector<uint64_t> keys;
-  keys.reserve(blocks_.size());
-  for (const auto& [key, pb] : blocks_)
-    if (Popcount(pb.surface) > 0) keys.push_back(key);
-  std::vector<std::vector<SurfaceVoxel>> per_block(keys.size());
+std::vector<MapSurfaceVoxel> PlanningMap::SurfaceVoxels() const {
+  // Entries of blocks still holding surface voxels carry over; stale ones are recomputed.
+  std::unordered_map<uint64_t, SurfaceCacheEntry> next;
+  next.reserve(blocks_.size());
+  std::vector<std::pair<uint64_t, SurfaceCacheEntry*>> stale;
+  size_t total = 0;
+  for (const auto& [key, pb] : blocks_) {
+    if (Popcount(pb.surface) == 0) continue;
+    SurfaceCacheEntry& entry = next[key];
+    const auto cached = surface_cache_.find(key);
+    if (cached != surface_cache_.end() && cached->second.revision == pb.revision) {
+      entry = std::move(cached->second);
+      total += entry.voxels.size();
+    } else {
+      entry.revision = pb.revision;
+      stale.emplace_back(key, &entry);
+    }
+  }
   const float s = volume_->voxel_size_m();
-  ParallelFor(keys.size(), 8, [&](size_t begin, size_t end) {
+  ParallelFor(stale.size(), 8, [&](size_t begin, size_t end) {
     for (size_t j = begin; j < end; ++j) {
-      const BlockIndex b = UnpackBlockIndex(keys[j]);
-      const TsdfBlock* tb = volume_->FindBlock(b);
+      const BlockIndex b = UnpackBlockIndex(stale[j].first);
+      const Neighbourhood n = NeighbourhoodOf(b);
+      const TsdfBlock* tb = n.self;
       if (!tb) continue;
-      ForEachBit(blocks_.at(keys[j]).surface, [&](int i) {
-        SurfaceVoxel v;
+      std::vector<MapSurfaceVoxel>& voxels = stale[j].second->voxels;
+      ForEachBit(blocks_.at(stale[j].first).surface, [&](int i) {
+        MapSurfaceVoxel v;
         v.index = GlobalOf(b, VoxelOfLinear(i));
         v.center_W = VoxelCenter(v.index, s);
-        v.normal_W = NormalAt(v.index);
+        v.normal_W = NormalIn(n, VoxelOfLinear(i));
         v.weight = DecodeWeight(tb->weight[i]);
         v.uncertainty = 1.0f / v.weight;
-        per_block[j].push_back(v);
+        voxels.push_back(v);
       });
     }
   });
-  std::vector<SurfaceVoxel> out;
-  for (auto& v : per_block) out.insert(out.end(), v.begin(), v.end());
-  std::sort(out.begin(), out.end(),
-            [](const SurfaceVoxel& a, const SurfaceVoxel& b) { return a.index < b.index; });
+  for (const auto& [key, entry] : stale) total += entry->voxels.size();
+  surface_cache_ = std::move(next);
+  std::vector<uint64_t> keys;
+  keys.reserve(surface_cache_.size());
+  for (const auto& [key, entry] : surface_cache_) keys.push_back(key);
+  std::sort(keys.begin(), keys.end());
+  std::vector<MapSurfaceVoxel> out;
+  out.reserve(total);
+  for (uint64_t key : keys) {
+    const std::vector<MapSurfaceVoxel>& voxels = surface_cache_.at(key).voxels;
+    const size_t first = out.size();
+    out.insert(out.end(), voxels.begin(), voxels.end());
+    // Labels change without a block update (FuseLabels), so they are read here, not cached.
+    const auto lb = labels_.find(key);
+    if (lb == labels_.end()) continue;
+    for (size_t i = first; i < out.size(); ++i)
+      out[i].label = FusedLabel(*lb->second, LinearIndex(LocalOf(out[i].index)));
+  }
   return out;
 }
 

@@ -59,12 +59,14 @@ struct PlanningMapParams {
   float label_band_vox = 0.5f;
 };
 
-struct SurfaceVoxel {
+// Not SurfaceVoxel: plugins/host/planner_world.h has the planner's, and explore uses both.
+struct MapSurfaceVoxel {
   GlobalVoxelIndex index;
   Eigen::Vector3f center_W;
   Eigen::Vector3f normal_W;  // unit; zero when the gradient vanishes
   float weight = 0.f;
   float uncertainty = 0.f;  // 1 / weight
+  uint32_t label = 0;       // fused instance label, 0: none
 };
 
 struct InstanceRecord {
@@ -127,7 +129,10 @@ class PlanningMap {
 
   // Sorted by voxel index (z, y, x).
   std::vector<GlobalVoxelIndex> FrontierVoxels() const;
-  std::vector<SurfaceVoxel> SurfaceVoxels() const;
+  // Block by block (blocks by index, voxels by linear index in the block). Blocks unchanged
+  // since the last call come from a cache (a planner asks every call, the map changes in a few
+  // places between calls), so calls must not overlap.
+  std::vector<MapSurfaceVoxel> SurfaceVoxels() const;
   // The fused label of a voxel (0: none) and its candidates.
   uint32_t LabelAt(GlobalVoxelIndex g) const;
   std::vector<std::pair<uint32_t, uint16_t>> LabelCandidatesAt(GlobalVoxelIndex g) const;
@@ -142,7 +147,14 @@ class PlanningMap {
  private:
   PlanningUpdateStats UpdateBlocks(const std::vector<BlockIndex>& touched);
   bool Observed(const TsdfBlock& b, int i) const { return b.weight[i] >= min_weight_fixed_; }
+  // A block and its six face neighbours (null where unallocated), in Neighbour() order.
+  struct Neighbourhood {
+    const TsdfBlock* self = nullptr;
+    const TsdfBlock* faces[6] = {};
+  };
+  Neighbourhood NeighbourhoodOf(BlockIndex b) const;
   Eigen::Vector3f NormalAt(GlobalVoxelIndex g) const;
+  Eigen::Vector3f NormalIn(const Neighbourhood& n, VoxelIndex v) const;
 
   const TsdfVolume* volume_;
   PlanningMapParams params_;
@@ -155,6 +167,14 @@ class PlanningMap {
   std::unordered_map<uint64_t, PlanningBlock> blocks_;  // PackBlockIndex -> sidecar
   std::unordered_map<uint64_t, std::unique_ptr<LabelBlock>> labels_;
   std::unordered_map<uint32_t, std::string> classes_;
+  // SurfaceVoxels per block, valid while the block's revision is unchanged: a block's surface
+  // voxels and their normals depend on its TSDF and its face neighbours', and UpdateBlocks
+  // stamps a block whenever it or a face neighbour was touched.
+  struct SurfaceCacheEntry {
+    uint64_t revision = 0;
+    std::vector<MapSurfaceVoxel> voxels;
+  };
+  mutable std::unordered_map<uint64_t, SurfaceCacheEntry> surface_cache_;
 };
 
 }  // namespace voxplan

@@ -2,6 +2,7 @@
 // brute force, uncertainty, normals, ray casts, label fusion and incremental vs rebuilt maps.
 #include <gtest/gtest.h>
 
+#include <optional>
 #include <random>
 #include <set>
 
@@ -125,14 +126,14 @@ TEST(PlanningMap, FrontierAndSurfaceMatchTheirDefinitionsAcrossBlockFaces) {
     EXPECT_NEAR(std::max(std::abs(d.y()), std::abs(d.z())) / 1.111f, d.x(), 3.f * kVoxel)
         << d.transpose();
   }
-  const std::vector<SurfaceVoxel> surface = fx.map.SurfaceVoxels();
+  const std::vector<MapSurfaceVoxel> surface = fx.map.SurfaceVoxels();
   std::set<GlobalVoxelIndex> surface_set;
-  for (const SurfaceVoxel& v : surface) surface_set.insert(v.index);
+  for (const MapSurfaceVoxel& v : surface) surface_set.insert(v.index);
   EXPECT_EQ(surface_set, BruteForce(fx.map, VoxelState::kOccupied, VoxelState::kFree));
   EXPECT_EQ(fx.map.CountSurface(), surface.size());
   // The seen wall is x = 1.49: its surface voxels are the last row before it, normals -x.
   size_t on_wall = 0;
-  for (const SurfaceVoxel& v : surface) {
+  for (const MapSurfaceVoxel& v : surface) {
     if (std::abs(v.center_W.x() - 1.475f) > 1e-4f || std::abs(v.center_W.y()) > 0.8f ||
         std::abs(v.center_W.z()) > 0.8f)
       continue;
@@ -151,7 +152,7 @@ TEST(PlanningMap, SurfaceUncertaintyFallsWithMoreObservations) {
   for (int k = 1; k <= 4; ++k) {
     fx.Fuse(pose);
     float found = -1.f;
-    for (const SurfaceVoxel& v : fx.map.SurfaceVoxels())
+    for (const MapSurfaceVoxel& v : fx.map.SurfaceVoxels())
       if (v.index == wall_voxel) found = v.uncertainty;
     ASSERT_GT(found, 0.f) << "wall voxel not a surface voxel after " << k << " frames";
     EXPECT_NEAR(found, 1.0f / float(k), 1e-3f);  // constant weighting: weight = frames
@@ -233,6 +234,13 @@ TEST(PlanningMap, LabelFusionKeepsTheMajorityAndCounts) {
     EXPECT_GT(on_wall, 100u);
   }
   EXPECT_GT(instances[0].bbox_min_W.y(), instances[1].bbox_min_W.y());  // 7 is the y > 0 side
+  // Surface voxels carry the same fused labels.
+  size_t labelled = 0;
+  for (const MapSurfaceVoxel& v : fx.map.SurfaceVoxels()) {
+    ASSERT_EQ(v.label, fx.map.LabelAt(v.index));
+    labelled += v.label != 0;
+  }
+  EXPECT_GT(labelled, 200u);
 }
 
 TEST(PlanningMap, IncrementalUpdateEqualsRebuild) {
@@ -259,6 +267,58 @@ TEST(PlanningMap, IncrementalUpdateEqualsRebuild) {
   }
   EXPECT_EQ(fx.map.FrontierVoxels(), rebuilt.FrontierVoxels());
   EXPECT_GT(fx.map.CountFrontier(), 0u);  // three of six walls unseen
+}
+
+// The normal rule of core/planning_map.h voxel by voxel through the volume: central differences
+// of observed TSDF values, one-sided next to unobserved voxels.
+Eigen::Vector3f ReferenceNormal(const TsdfVolume& volume, GlobalVoxelIndex g,
+                                const VoxelStateParams& state) {
+  auto tsdf = [&](GlobalVoxelIndex q) -> std::optional<float> {
+    const TsdfBlock* b = volume.FindBlock(BlockOf(q));
+    if (!b) return std::nullopt;
+    const int i = LinearIndex(LocalOf(q));
+    if (DecodeWeight(b->weight[i]) < state.min_weight) return std::nullopt;
+    return DecodeTsdf(b->tsdf[i]);
+  };
+  const std::optional<float> c = tsdf(g);
+  Eigen::Vector3f grad = Eigen::Vector3f::Zero();
+  for (int k = 0; k < 3; ++k) {
+    const std::optional<float> m = tsdf(Add(g, kFaces[2 * k])), p = tsdf(Add(g, kFaces[2 * k + 1]));
+    if (m && p) {
+      grad[k] = 0.5f * (*p - *m);
+    } else if (p && c) {
+      grad[k] = *p - *c;
+    } else if (m && c) {
+      grad[k] = *c - *m;
+    }
+  }
+  const float n = grad.norm();
+  return n > 0.f ? Eigen::Vector3f(grad / n) : Eigen::Vector3f::Zero();
+}
+
+// SurfaceVoxels asked between frames (so later calls reuse cached blocks) equals a fresh map's,
+// and its normals (read through each block's face neighbours) equal the voxel-by-voxel rule.
+TEST(PlanningMap, CachedSurfaceVoxelsEqualAFreshMapsAfterEveryFrame) {
+  Fixture fx;
+  const std::vector<Pose3f> views = test::AxisViews(kEye);
+  size_t largest = 0;
+  for (int k : {0, 2, 5, 1, 0, 3}) {
+    fx.Fuse(views[size_t(k)]);
+    const std::vector<MapSurfaceVoxel> cached = fx.map.SurfaceVoxels();
+    PlanningMap fresh(fx.volume);
+    fresh.Rebuild();
+    const std::vector<MapSurfaceVoxel> expected = fresh.SurfaceVoxels();
+    ASSERT_EQ(cached.size(), expected.size()) << "after view " << k;
+    for (size_t i = 0; i < cached.size(); ++i) {
+      ASSERT_EQ(cached[i].index, expected[i].index);
+      // Bitwise: a stale normal next to a changed face neighbour would differ here.
+      ASSERT_EQ(cached[i].normal_W, expected[i].normal_W) << "voxel " << i << " after view " << k;
+      ASSERT_EQ(cached[i].weight, expected[i].weight);
+      ASSERT_EQ(cached[i].normal_W, ReferenceNormal(fx.volume, cached[i].index, {}));
+    }
+    largest = std::max(largest, cached.size());
+  }
+  EXPECT_GT(largest, 1000u);
 }
 
 // The per-block masks (fixed-point thresholds, SIMD on x86-64) against ClassifyVoxel itself,
