@@ -261,7 +261,7 @@ double DistanceUpTo(const std::vector<RobotTrack>& tracks, double t_s) {
 
 double FloorArea(const FloorPlan& plan) {
   const size_t floor_cells = size_t(std::count_if(
-      plan.cells.begin(), plan.cells.end(), [](FloorCell c) { return c != FloorCell::kOutside; }));
+      plan.cells.begin(), plan.cells.end(), [](PlanCell c) { return c != PlanCell::kOutside; }));
   return double(floor_cells) * double(plan.resolution_m) * double(plan.resolution_m);
 }
 
@@ -278,7 +278,7 @@ Result<double> FloorCoverage(const FloorPlan& truth, const ObservedRaster& obser
   size_t free_cells = 0, known = 0;
   for (int y = 0; y < truth.height; ++y) {
     for (int x = 0; x < truth.width; ++x) {
-      if (truth.at(x, y) != FloorCell::kFree) continue;
+      if (truth.at(x, y) != PlanCell::kFree) continue;
       ++free_cells;
       const Eigen::Vector2d centre = truth.CellCenter(x, y).cast<double>();
       const Eigen::Vector2d cell = (centre - observed.origin_W) / observed.resolution_m;

@@ -212,11 +212,11 @@ Result<FloorPlan> RasterizeFloorPlan(const World& world, const FloorPlanParams& 
   plan.cells.resize(n);
   for (size_t i = 0; i < n; ++i) {
     if (band[i] || (params.fill_solids && up_back[i]))
-      plan.cells[i] = FloorCell::kObstacle;
+      plan.cells[i] = PlanCell::kObstacle;
     else if (floor[i])
-      plan.cells[i] = FloorCell::kFree;
+      plan.cells[i] = PlanCell::kFree;
     else
-      plan.cells[i] = FloorCell::kOutside;
+      plan.cells[i] = PlanCell::kOutside;
   }
   return plan;
 }

@@ -11,7 +11,8 @@
 
 namespace voxplan {
 
-enum class FloorCell : uint8_t {
+// A true-plan cell (not core/floor_map.h's FloorCell, the robots' own map: explore uses both).
+enum class PlanCell : uint8_t {
   kFree = 0,      // floor below, nothing in the height band above
   kObstacle = 1,  // a triangle crosses the height band over this cell
   kOutside = 2,   // no floor below (outside the building)
@@ -35,11 +36,11 @@ struct FloorPlanParams {
 struct FloorPlan {
   Eigen::Vector2f origin_W = Eigen::Vector2f::Zero();  // world x, y of cell (0, 0)'s corner
   float resolution_m = 0.05f;
-  int width = 0, height = 0;     // cells along x and y
-  std::vector<FloorCell> cells;  // row-major, y rows
+  int width = 0, height = 0;    // cells along x and y
+  std::vector<PlanCell> cells;  // row-major, y rows
 
   bool Contains(int x, int y) const { return x >= 0 && y >= 0 && x < width && y < height; }
-  FloorCell at(int x, int y) const { return cells[size_t(y) * width + x]; }
+  PlanCell at(int x, int y) const { return cells[size_t(y) * width + x]; }
   Eigen::Vector2f CellCenter(int x, int y) const {
     return origin_W + resolution_m * Eigen::Vector2f(x + 0.5f, y + 0.5f);
   }

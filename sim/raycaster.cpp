@@ -221,15 +221,18 @@ RenderOutput MeshRaycaster::Render(const PinholeCamera& camera, const Pose3f& T_
             if (params.labels && !impl.triangle_instance.empty())
               out.labels.at(u, v) = impl.triangle_instance[prim];
             if (params.normals) {
-              // Ng is unnormalised and world-frame; R^T takes it to the camera frame, where the
-              // ray is (x_C, y_C, 1).
-              const Eigen::Vector3f ng_W(rayhit.hit.Ng_x[i], rayhit.hit.Ng_y[i],
-                                         rayhit.hit.Ng_z[i]);
-              Eigen::Vector3f n_C = (R_W_C.transpose() * ng_W).normalized();
-              const Eigen::Vector3f ray_C((float(u) - camera.cx) / camera.fx,
-                                          (float(v) - camera.cy) / camera.fy, 1.f);
-              if (n_C.dot(ray_C) > 0.f) n_C = -n_C;
-              out.normals_C.at(u, v) = n_C;
+              // Ng is unnormalised and world-frame. Turned against the lane's own world ray (a
+              // rotation keeps the dot product's sign) and scaled by one reciprocal: the
+              // divisions of a per-pixel camera ray and of normalized() were most of this loop.
+              const float nx = rayhit.hit.Ng_x[i], ny = rayhit.hit.Ng_y[i], nz = rayhit.hit.Ng_z[i];
+              const float along =
+                  nx * rayhit.ray.dir_x[i] + ny * rayhit.ray.dir_y[i] + nz * rayhit.ray.dir_z[i];
+              const float norm2 = nx * nx + ny * ny + nz * nz;
+              if (norm2 > 0.f) {
+                const float scale = (along > 0.f ? -1.f : 1.f) / std::sqrt(norm2);
+                out.normals_C.at(u, v) =
+                    R_W_C.transpose() * Eigen::Vector3f(nx * scale, ny * scale, nz * scale);
+              }
             }
           }
         }

@@ -101,12 +101,12 @@ bool FootprintFree(const FloorPlan& plan, const Eigen::Vector2f& p_W, float radi
     for (int x = x0; x <= x1; ++x) {
       if ((plan.CellCenter(x, y) - p_W).squaredNorm() > r2) continue;
       any = true;
-      if (!plan.Contains(x, y) || plan.at(x, y) != FloorCell::kFree) return false;
+      if (!plan.Contains(x, y) || plan.at(x, y) != PlanCell::kFree) return false;
     }
   if (!any) {  // footprint smaller than a cell: the cell under the centre decides
     const Eigen::Vector2f c = (p_W - plan.origin_W) / res;
     const int x = int(std::floor(c.x())), y = int(std::floor(c.y()));
-    return plan.Contains(x, y) && plan.at(x, y) == FloorCell::kFree;
+    return plan.Contains(x, y) && plan.at(x, y) == PlanCell::kFree;
   }
   return true;
 }

@@ -33,39 +33,128 @@ struct PixelRng {
   uint64_t Bits(size_t pixel, uint64_t stream) const {
     return SplitMix64(frame_key ^ (uint64_t(pixel) * kNumStreams + stream));
   }
-  // Two uniforms in [0, 1) from one hash.
-  std::pair<double, double> Uniform2(size_t pixel, uint64_t stream) const {
-    const uint64_t b = Bits(pixel, stream);
-    return {double(b >> 32) / kTwoPow32, double(b & 0xffffffffu) / kTwoPow32};
-  }
-  // A standard normal (Box-Muller, one of the pair); |x| <= 6.7 with 32-bit uniforms.
-  float Gaussian(size_t pixel, uint64_t stream) const {
-    const auto [a, b] = Uniform2(pixel, stream);
-    const float u1 = float(1.0 - a);  // (0, 1]: log stays finite
-    return std::sqrt(-2.f * std::log(u1)) * std::cos(2.f * std::numbers::pi_v<float> * float(b));
-  }
 };
 
-// The pixel shift round(N(0, σ)) by inverse CDF over a small table: two uniform draws per pixel
-// instead of a Box-Muller pair (log, sqrt, sin, cos dominated the noise pass).
+// Uniform in (0, 1] from 32 bits: log() of it stays finite.
+double UniformOpen(uint64_t bits32) { return (double(bits32 & 0xffffffffu) + 1.0) / kTwoPow32; }
+
+// Standard normals by Marsaglia and Tsang's ziggurat (2000, 128 layers): one 64-bit hash gives
+// one draw ~98.8 % of the time with a compare and a multiply; Box-Muller's log, sqrt and cos per
+// pixel cost as much as rendering the frame. The layer index comes from bits apart from the
+// value's, which avoids the correlation of the original (one 32-bit word for both).
+class Ziggurat {
+ public:
+  Ziggurat() {
+    const double m1 = 2147483648.0;  // 2^31: |hz| of a signed 32-bit draw
+    double dn = kR, tn = kR;
+    const double q = kV / std::exp(-0.5 * dn * dn);
+    kn_[0] = uint32_t(dn / q * m1);
+    kn_[1] = 0;
+    wn_[0] = q / m1;
+    wn_[127] = dn / m1;
+    fn_[0] = 1.0;
+    fn_[127] = std::exp(-0.5 * dn * dn);
+    for (int i = 126; i >= 1; --i) {
+      dn = std::sqrt(-2.0 * std::log(kV / dn + std::exp(-0.5 * dn * dn)));
+      kn_[i + 1] = uint32_t(dn / tn * m1);
+      tn = dn;
+      fn_[i] = std::exp(-0.5 * dn * dn);
+      wn_[i] = dn / m1;
+    }
+  }
+
+  // `bits` are the pixel's random word; `more()` gives further words for the rare rejections,
+  // so the draw stays a function of the pixel's hash alone.
+  template <class More>
+  float Sample(uint64_t bits, More&& more) const {
+    for (;;) {
+      const int32_t hz = int32_t(uint32_t(bits >> 32));
+      const uint32_t iz = uint32_t(bits) & 127u;
+      const uint32_t mag = uint32_t(hz < 0 ? -int64_t(hz) : int64_t(hz));
+      const double x = double(hz) * wn_[iz];
+      if (mag < kn_[iz]) return float(x);  // inside the layer's rectangle
+      if (iz == 0) {                       // the base layer's tail beyond kR (Marsaglia 1964)
+        double xt = 0.0, y = 0.0;
+        do {
+          const uint64_t b = more();
+          xt = -std::log(UniformOpen(b >> 32)) / kR;
+          y = -std::log(UniformOpen(b));
+        } while (y + y < xt * xt);
+        return float(hz > 0 ? kR + xt : -(kR + xt));
+      }
+      // The wedge between the rectangle and the density.
+      const double u = double(more() >> 11) * 0x1p-53;
+      if (fn_[iz] + u * (fn_[iz - 1] - fn_[iz]) < std::exp(-0.5 * x * x)) return float(x);
+      bits = more();
+    }
+  }
+
+ private:
+  static constexpr double kR = 3.442619855899;       // start of the tail
+  static constexpr double kV = 9.91256303526217e-3;  // area of each layer
+  uint32_t kn_[128];
+  double wn_[128], fn_[128];
+};
+
+const Ziggurat& StandardNormal() {
+  static const Ziggurat table;
+  return table;
+}
+
+// The pixel shift round(N(0, σ)) by inverse CDF: the count of 32-bit thresholds a uniform word
+// reaches. A table over the word's top byte answers at once wherever its bucket holds a single
+// shift (all but a few of the 256); only buckets that straddle a threshold count.
 class RoundedGaussian {
  public:
   explicit RoundedGaussian(float sigma) {
     if (!(sigma > 0.f)) return;
     const int k_max = std::min(64, int(std::ceil(6.f * sigma)) + 1);
     offset_ = -k_max;
-    for (int k = -k_max; k < k_max; ++k)  // cdf_[i] = P(round(x) <= offset_ + i)
-      cdf_.push_back(0.5 * std::erfc(-(double(k) + 0.5) / (double(sigma) * std::numbers::sqrt2)));
+    for (int k = -k_max; k < k_max; ++k) {
+      // P(round(x) <= k) scaled to 32 bits: word >= threshold <=> word / 2^32 >= P.
+      const double cdf =
+          0.5 * std::erfc(-(double(k) + 0.5) / (double(sigma) * std::numbers::sqrt2));
+      thresholds_.push_back(uint64_t(std::ceil(cdf * kTwoPow32)));
+    }
+    for (uint32_t b = 0; b < 256; ++b) {
+      const int lo = Count(b << 24), hi = Count((b << 24) | 0xffffffu);
+      bucket_[b] = lo == hi ? int8_t(offset_ + lo) : kStraddles;
+    }
   }
-  int Sample(double uniform) const {
-    if (cdf_.empty()) return 0;
-    return offset_ + int(std::upper_bound(cdf_.begin(), cdf_.end(), uniform) - cdf_.begin());
+  int Sample(uint32_t word) const {
+    const int8_t s = bucket_[word >> 24];
+    return s != kStraddles ? s : offset_ + Count(word);
   }
+  bool empty() const { return thresholds_.empty(); }
 
  private:
+  static constexpr int8_t kStraddles = -128;  // shifts are within [-64, 64]
+  int Count(uint32_t word) const {
+    int count = 0;
+    for (uint64_t t : thresholds_) count += uint64_t(word) >= t ? 1 : 0;
+    return count;
+  }
   int offset_ = 0;
-  std::vector<double> cdf_;
+  std::vector<uint64_t> thresholds_;
+  int8_t bucket_[256] = {};
 };
+
+// The disparity model with f b / step precomputed: one division to the disparity index, one back.
+struct Quantizer {
+  float fb_per_step;
+  float operator()(float z_m) const {
+    if (!(z_m > 0.f)) return 0.f;
+    const float x = fb_per_step / z_m + 0.5f;
+    if (x < 1.f) return 0.f;  // beyond the farthest representable disparity: no return
+    // floor(): truncation for positive values, which fit an int below 2^24 (whole above).
+    const float steps = x < 16777216.f ? float(int32_t(x)) : x;
+    return fb_per_step / steps;
+  }
+};
+
+Quantizer MakeQuantizer(const KinectNoiseParams& params, float focal_px) {
+  return {std::abs(focal_px) * params.baseline_m / params.disparity_step_px};
+}
 
 PixelRng MakeRng(uint64_t seed, uint64_t frame) {
   return {SplitMix64(SplitMix64(seed) ^ SplitMix64(frame + 0x632be59bd9b4e019ull))};
@@ -98,11 +187,7 @@ float AxialSigma(const KinectNoiseParams& params, float z_m) {
 }
 
 float QuantizeDepth(const KinectNoiseParams& params, float focal_px, float z_m) {
-  if (!(z_m > 0.f)) return 0.f;
-  const float fb = std::abs(focal_px) * params.baseline_m;
-  const float steps = std::floor(fb / (z_m * params.disparity_step_px) + 0.5f);
-  if (steps < 1.f) return 0.f;  // beyond the farthest representable disparity: no return
-  return fb / (steps * params.disparity_step_px);
+  return MakeQuantizer(params, focal_px)(z_m);
 }
 
 Image<Eigen::Vector3f> NormalsFromDepth(const DepthImage& depth, const PinholeCamera& camera,
@@ -163,87 +248,94 @@ Result<DepthImage> ApplyKinectNoise(const DepthImage& depth,
   for (int u = 0; u < w; ++u) ray_x[size_t(u)] = (float(u) - camera.cx) / camera.fx;
   for (int v = 0; v < h; ++v) ray_y[size_t(v)] = (float(v) - camera.cy) / camera.fy;
 
-  // The nearest valid depth within edge_radius_px (a separable min filter; misses count as
-  // infinitely far): a pixel farther than it by the jump lies on the far side of an edge.
+  // Pass 1: which clean pixels survive the dropouts (1 = kept). The edge test compares a pixel
+  // with the nearest valid depth within edge_radius_px (a separable min filter, misses counting
+  // as infinitely far), done per chunk of rows with the r rows around it.
   const bool edges = params.edge_dropout && params.edge_dropout_probability > 0.f;
-  DepthImage nearest;
-  if (edges) {
-    const int r = params.edge_radius_px;
-    const float far = std::numeric_limits<float>::infinity();
-    DepthImage row_min(w, h, far);
-    nearest = DepthImage(w, h, far);
-    ParallelFor(size_t(h), 16, [&](size_t begin, size_t end) {
-      for (size_t v = begin; v < end; ++v)
+  const int r = edges ? params.edge_radius_px : 0;
+  const float far = std::numeric_limits<float>::infinity();
+  const float min_cos2 = min_cos * min_cos;
+  std::vector<uint8_t> kept(size_t(w) * size_t(h), 0);
+  ParallelFor(size_t(h), 16, [&](size_t begin, size_t end) {
+    const int v_lo = std::max(0, int(begin) - r), v_hi = std::min(h, int(end) + r);
+    std::vector<float> row_min;
+    if (edges) {
+      row_min.assign(size_t(v_hi - v_lo) * size_t(w), far);
+      for (int v = v_lo; v < v_hi; ++v) {
+        const float* z_row = &depth.at(0, v);
+        float* m_row = &row_min[size_t(v - v_lo) * size_t(w)];
         for (int u = 0; u < w; ++u) {
           float m = far;
-          for (int uu = std::max(0, u - r); uu <= std::min(w - 1, u + r); ++uu) {
-            const float z = depth.at(uu, int(v));
-            if (z > 0.f) m = std::min(m, z);
-          }
-          row_min.at(u, int(v)) = m;
-        }
-    });
-    ParallelFor(size_t(h), 16, [&](size_t begin, size_t end) {
-      for (size_t v = begin; v < end; ++v) {
-        const int v0 = std::max(0, int(v) - r), v1 = std::min(h - 1, int(v) + r);
-        for (int u = 0; u < w; ++u) {
-          float m = far;
-          for (int vv = v0; vv <= v1; ++vv) m = std::min(m, row_min.at(u, vv));
-          nearest.at(u, int(v)) = m;
+          for (int uu = std::max(0, u - r); uu <= std::min(w - 1, u + r); ++uu)
+            m = std::min(m, z_row[uu] > 0.f ? z_row[uu] : far);
+          m_row[u] = m;
         }
       }
-    });
-  }
-
-  // Pass 1: dropouts on the clean image.
-  const float min_cos2 = min_cos * min_cos;
-  DepthImage kept = depth;
-  ParallelFor(size_t(h), 8, [&](size_t begin, size_t end) {
+    }
+    std::vector<float> nearest(edges ? size_t(w) : 0);
     for (size_t row = begin; row < end; ++row) {
       const int v = int(row);
+      const float* z_row = &depth.at(0, v);
+      uint8_t* k_row = &kept[row * size_t(w)];
+      if (edges) {
+        const int v0 = std::max(0, v - r), v1 = std::min(h - 1, v + r);
+        std::copy_n(&row_min[size_t(v0 - v_lo) * size_t(w)], w, nearest.begin());
+        for (int vv = v0 + 1; vv <= v1; ++vv) {
+          const float* m_row = &row_min[size_t(vv - v_lo) * size_t(w)];
+          for (int u = 0; u < w; ++u) nearest[size_t(u)] = std::min(nearest[size_t(u)], m_row[u]);
+        }
+      }
       const float ry = ray_y[row];
       for (int u = 0; u < w; ++u) {
-        const float z = depth.at(u, v);
+        const float z = z_row[u];
         if (!(z > 0.f)) continue;
         if (params.grazing_dropout) {
           // |n . r| < cos(max) |r| with a unit normal, squared (no square roots).
           const Eigen::Vector3f& n = normals->at(u, v);
           const float rx = ray_x[size_t(u)];
           const float dot = n.x() * rx + n.y() * ry + n.z();
-          if (n.squaredNorm() > 0.f && dot * dot < min_cos2 * (rx * rx + ry * ry + 1.f)) {
-            kept.at(u, v) = 0.f;
-            continue;
-          }
+          if (n.squaredNorm() > 0.f && dot * dot < min_cos2 * (rx * rx + ry * ry + 1.f)) continue;
         }
-        if (edges && z - nearest.at(u, v) > params.edge_jump_m + params.edge_jump_fraction * z) {
+        if (edges && z - nearest[size_t(u)] > params.edge_jump_m + params.edge_jump_fraction * z) {
           const size_t pixel = size_t(v) * size_t(w) + size_t(u);
-          if (rng.Uniform2(pixel, kEdge).first < params.edge_dropout_probability)
-            kept.at(u, v) = 0.f;
+          if (double(rng.Bits(pixel, kEdge) >> 32) / kTwoPow32 < params.edge_dropout_probability)
+            continue;
         }
+        k_row[u] = 1;
       }
     }
   });
 
   // Pass 2: lateral jitter, axial noise and quantisation per output pixel.
   DepthImage out(w, h, 0.f);
-  const float focal = std::abs(camera.fx);
   const RoundedGaussian shift(params.lateral_sigma_px);
-  ParallelFor(size_t(h), 8, [&](size_t begin, size_t end) {
+  const bool lateral = params.lateral && !shift.empty();
+  const Ziggurat& normal = StandardNormal();
+  const Quantizer quantize = MakeQuantizer(params, camera.fx);
+  const float s0 = params.axial_sigma0_m, s2 = params.axial_sigma2, z0 = params.axial_z0_m;
+  ParallelFor(size_t(h), 16, [&](size_t begin, size_t end) {
     for (size_t row = begin; row < end; ++row) {
       const int v = int(row);
+      float* out_row = &out.at(0, v);
       for (int u = 0; u < w; ++u) {
         const size_t pixel = size_t(v) * size_t(w) + size_t(u);
         int su = u, sv = v;
-        if (params.lateral) {
-          const auto [a, b] = rng.Uniform2(pixel, kLateral);
-          su = std::clamp(u + shift.Sample(a), 0, w - 1);
-          sv = std::clamp(v + shift.Sample(b), 0, h - 1);
+        if (lateral) {
+          const uint64_t b = rng.Bits(pixel, kLateral);
+          su = std::clamp(u + shift.Sample(uint32_t(b >> 32)), 0, w - 1);
+          sv = std::clamp(v + shift.Sample(uint32_t(b)), 0, h - 1);
         }
-        float z = kept.at(su, sv);
-        if (!(z > 0.f)) continue;
-        if (params.axial) z += AxialSigma(params, z) * rng.Gaussian(pixel, kAxial);
-        if (params.quantize) z = QuantizeDepth(params, focal, z);
-        out.at(u, v) = z > 0.f ? z : 0.f;
+        const size_t source = size_t(sv) * size_t(w) + size_t(su);
+        if (!kept[source]) continue;
+        float z = depth.data[source];
+        if (params.axial) {
+          uint64_t key = rng.Bits(pixel, kAxial);
+          const float n = normal.Sample(key, [&key] { return key = SplitMix64(key); });
+          const float dz = z - z0;
+          z += (s0 + s2 * dz * dz) * n;
+        }
+        if (params.quantize) z = quantize(z);
+        out_row[u] = z > 0.f ? z : 0.f;
       }
     }
   });

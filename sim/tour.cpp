@@ -64,7 +64,7 @@ struct Grid {
     const int steps = int(std::ceil((b - a).norm() / (0.5f * plan.resolution_m)));
     for (int k = 1; k < steps; ++k) {
       const int c = CellAt(a + (b - a) * (float(k) / float(steps)));
-      if (c < 0 || plan.cells[size_t(c)] == FloorCell::kObstacle) return false;
+      if (c < 0 || plan.cells[size_t(c)] == PlanCell::kObstacle) return false;
     }
     return true;
   }
@@ -77,7 +77,7 @@ std::vector<float> Clearance(const FloorPlan& plan) {
   using Item = std::pair<float, int>;
   std::priority_queue<Item, std::vector<Item>, std::greater<>> queue;
   for (size_t i = 0; i < n; ++i)
-    if (plan.cells[i] != FloorCell::kFree) {
+    if (plan.cells[i] != PlanCell::kFree) {
       dist[i] = 0.f;
       queue.push({0.f, int(i)});
     }
@@ -193,17 +193,32 @@ struct Recorder {
     }
     return Status::Ok();
   }
-  void Spin() {
+  // Tilts the camera to `pitch_deg` in steps of at most frame_step_deg, a frame after each.
+  Status TiltTo(float pitch_deg) {
+    const float start = robot.state().camera_pitch_rad;
+    const float delta = Deg2Rad(pitch_deg) - start;
+    const int steps = int(std::ceil(std::abs(delta) / Deg2Rad(params.frame_step_deg) - 1e-4f));
+    for (int k = 1; k <= steps; ++k) {
+      VOXPLAN_RETURN_IF_ERROR(robot.SetCameraPitch(start + delta * float(k) / float(steps)));
+      Emit();
+    }
+    return Status::Ok();
+  }
+  Status Spin() {
     robot.Dwell();
     Emit();
     const int steps = std::max(1, int(std::ceil(360.f / params.frame_step_deg - 1e-4f)));
-    const float start = robot.state().camera_yaw_rad;
-    for (int k = 1; k <= steps; ++k) {
-      robot.SetCameraYaw(start + 2.f * kPi * float(k) / float(steps));
-      robot.Dwell();
-      Emit();  // the last one repeats the first view: later turns then start from it
+    for (const float pitch_deg : params.spin_pitches_deg) {
+      VOXPLAN_RETURN_IF_ERROR(TiltTo(pitch_deg));
+      const float start = robot.state().camera_yaw_rad;
+      for (int k = 1; k <= steps; ++k) {
+        robot.SetCameraYaw(start + 2.f * kPi * float(k) / float(steps));
+        robot.Dwell();
+        Emit();  // the last one repeats the first view: later turns then start from it
+      }
+      robot.WrapCameraYaw();
     }
-    robot.WrapCameraYaw();
+    return TiltTo(params.camera_pitch_deg);
   }
 };
 
@@ -221,6 +236,13 @@ Status TourParams::Validate() const {
     return InvalidArgument("TourParams: frame_step_m must be > 0, frame_step_deg in (0, 90]");
   if (!(std::abs(camera_pitch_deg) <= robot.max_abs_pitch_deg))
     return InvalidArgument("TourParams: camera_pitch_deg beyond the robot's pitch limit");
+  if (spin_pitches_deg.empty())
+    return InvalidArgument("TourParams: spin_pitches_deg needs at least one pitch");
+  for (const float pitch_deg : spin_pitches_deg)
+    if (!(std::abs(pitch_deg) <= robot.max_abs_pitch_deg))
+      return InvalidArgument("TourParams: spin pitch " + std::to_string(pitch_deg) +
+                             " deg is beyond the robot's pitch limit of " +
+                             std::to_string(robot.max_abs_pitch_deg) + " deg");
   if (start_W && !start_W->allFinite()) return InvalidArgument("TourParams: start is not finite");
   return Status::Ok();
 }
@@ -266,7 +288,7 @@ Result<Tour> PlanTour(const FloorPlan& plan, const std::vector<Room>& rooms,
   }
   if (component_size.empty()) {
     const size_t free_cells =
-        size_t(std::count(plan.cells.begin(), plan.cells.end(), FloorCell::kFree));
+        size_t(std::count(plan.cells.begin(), plan.cells.end(), PlanCell::kFree));
     return InvalidArgument("PlanTour: no free cell leaves room for a robot of radius " +
                            std::to_string(radius) + " m (" + std::to_string(free_cells) + " of " +
                            std::to_string(n) + " floor plan cells are free)");
@@ -425,7 +447,7 @@ Result<Tour> PlanTour(const FloorPlan& plan, const std::vector<Room>& rooms,
     }
     tour.viewpoints_W.push_back(robot->state().position_W);
     tour.viewpoint_room.push_back(viewpoint_rooms[size_t(order[k])]);
-    rec.Spin();
+    VOXPLAN_RETURN_IF_ERROR(rec.Spin().WithContext("PlanTour"));
   }
   tour.length_m = robot->distance_m();
   tour.duration_s = robot->clock_s();

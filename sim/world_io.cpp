@@ -161,10 +161,10 @@ Status WriteFloorPlanPng(const FloorPlan& plan, const std::string& path) {
   std::vector<uint8_t> pixels(plan.cells.size());
   for (int y = 0; y < plan.height; ++y)
     for (int x = 0; x < plan.width; ++x) {
-      const FloorCell c = plan.at(x, y);
-      pixels[size_t(plan.height - 1 - y) * plan.width + x] = c == FloorCell::kFree       ? 255
-                                                             : c == FloorCell::kObstacle ? 0
-                                                                                         : 128;
+      const PlanCell c = plan.at(x, y);
+      pixels[size_t(plan.height - 1 - y) * plan.width + x] = c == PlanCell::kFree       ? 255
+                                                             : c == PlanCell::kObstacle ? 0
+                                                                                        : 128;
     }
   return WritePngRaw(path, plan.width, plan.height, 1, 8, pixels.data());
 }

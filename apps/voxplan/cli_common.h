@@ -37,6 +37,7 @@ Command AddDemoCommand(CLI::App& app);
 Command AddRenderCommand(CLI::App& app);
 Command AddBenchCommand(CLI::App& app);
 Command AddSimCommand(CLI::App& app);
+Command AddExploreCommand(CLI::App& app);  // explore (cmd_explore.cpp)
 // Subcommands that live in their own files, added to a parent command above.
 Command AddSimSceneCommand(CLI::App& sim);     // sim scene   (cmd_sim_scene.cpp)
 Command AddSimRenderCommand(CLI::App& sim);    // sim render  (cmd_sim_render.cpp)

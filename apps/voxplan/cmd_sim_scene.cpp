@@ -113,9 +113,9 @@ int RunSimScene(const SimSceneOptions& o) {
 
   const FloorPlan& plan = written->floor_plan;
   size_t free_cells = 0, inside_cells = 0;
-  for (FloorCell c : plan.cells) {
-    free_cells += c == FloorCell::kFree;
-    inside_cells += c != FloorCell::kOutside;
+  for (PlanCell c : plan.cells) {
+    free_cells += c == PlanCell::kFree;
+    inside_cells += c != PlanCell::kOutside;
   }
   const double cell_area = double(plan.resolution_m) * plan.resolution_m;
   double room_area = 0.0;

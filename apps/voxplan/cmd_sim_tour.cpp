@@ -1,5 +1,6 @@
 // voxplan sim tour: plan a deterministic camera tour that sees every room of a scene (floor plan,
-// viewpoint cover, ordered visits, a 360° spin at each) and write it as a TUM trajectory.
+// viewpoint cover, ordered visits, 360° spins level, up and down at each) and write it as a TUM
+// trajectory.
 #include <cstdio>
 #include <filesystem>
 #include <iostream>
@@ -26,7 +27,8 @@ struct SimTourOptions {
   double radius = 0.2;
   double camera_height = 1.2;
   double pitch_deg = 0.0;
-  double view_range = 3.0;
+  std::vector<double> spin_pitches_deg = {0.0, 45.0, -45.0};
+  double view_range = 2.0;
   double resolution = 0.05;
   double frame_step = 0.1;
   double frame_step_deg = 10.0;
@@ -46,6 +48,7 @@ int RunSimTour(const SimTourOptions& o) {
   params.robot.radius_m = float(o.radius);
   params.robot.camera_height_m = float(o.camera_height);
   params.camera_pitch_deg = float(o.pitch_deg);
+  params.spin_pitches_deg.assign(o.spin_pitches_deg.begin(), o.spin_pitches_deg.end());
   params.view_range_m = float(o.view_range);
   params.frame_step_m = float(o.frame_step);
   params.frame_step_deg = float(o.frame_step_deg);
@@ -86,6 +89,7 @@ int RunSimTour(const SimTourOptions& o) {
   j["mode"] = o.mode;
   j["frames"] = tour->T_W_C.size();
   j["viewpoints"] = tour->viewpoints_W.size();
+  j["spin_pitches_deg"] = o.spin_pitches_deg;
   j["rooms"] = world->rooms.size();
   nlohmann::json unreachable = nlohmann::json::array();
   for (int r : tour->unreachable_rooms) unreachable.push_back(world->rooms[size_t(r)].name);
@@ -123,7 +127,12 @@ Command AddSimTourCommand(CLI::App& sim) {
   sub->add_option("--camera-height", o->camera_height, "Camera height above the floor, metres")
       ->check(Positive())
       ->capture_default_str();
-  sub->add_option("--pitch", o->pitch_deg, "Camera pitch, degrees (positive looks up)")
+  sub->add_option("--pitch", o->pitch_deg,
+                  "Camera pitch while driving, degrees (positive looks up)")
+      ->capture_default_str();
+  sub->add_option("--spin-pitches", o->spin_pitches_deg,
+                  "Camera pitch of each 360° spin at a viewpoint, degrees, comma-separated")
+      ->delimiter(',')
       ->capture_default_str();
   sub->add_option("--view-range", o->view_range, "Range a viewpoint covers, metres")
       ->check(Positive())

@@ -18,9 +18,10 @@ int main(int argc, char** argv) {
     return "error: " + std::string(e.what()) + "\nRun with --help for more information.\n";
   });
 
-  std::vector<Command> commands = {AddFuseCommand(app),  AddMeshCommand(app), AddInfoCommand(app),
-                                   AddEvalCommand(app),  AddDemoCommand(app), AddRenderCommand(app),
-                                   AddBenchCommand(app), AddSimCommand(app)};
+  std::vector<Command> commands = {
+      AddFuseCommand(app),  AddMeshCommand(app), AddInfoCommand(app),
+      AddEvalCommand(app),  AddDemoCommand(app), AddRenderCommand(app),
+      AddBenchCommand(app), AddSimCommand(app),  AddExploreCommand(app)};
   try {
     app.parse(argc, argv);
   } catch (const CLI::CallForHelp& e) {

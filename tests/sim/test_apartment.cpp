@@ -78,11 +78,11 @@ std::vector<uint8_t> RobotSpace(const FloorPlan& plan, float radius) {
   std::vector<uint8_t> ok(plan.cells.size(), 0);
   for (int y = 0; y < plan.height; ++y)
     for (int x = 0; x < plan.width; ++x) {
-      if (plan.at(x, y) != FloorCell::kFree) continue;
+      if (plan.at(x, y) != PlanCell::kFree) continue;
       bool clear = true;
       for (const auto& o : offsets) {
         const int a = x + o[0], b = y + o[1];
-        if (!plan.Contains(a, b) || plan.at(a, b) != FloorCell::kFree) {
+        if (!plan.Contains(a, b) || plan.at(a, b) != PlanCell::kFree) {
           clear = false;
           break;
         }
@@ -206,11 +206,11 @@ void CheckApartment(const World& w, ApartmentSize size, const std::string& what)
   ASSERT_TRUE(plan.ok()) << plan.status().message();
   for (int y = 0; y < plan->height; ++y)
     for (int x = 0; x < plan->width; ++x) {
-      if (plan->at(x, y) != FloorCell::kFree) continue;
+      if (plan->at(x, y) != PlanCell::kFree) continue;
       for (int dy = -1; dy <= 1; ++dy)
         for (int dx = -1; dx <= 1; ++dx)
           ASSERT_TRUE(plan->Contains(x + dx, y + dy) &&
-                      plan->at(x + dx, y + dy) != FloorCell::kOutside)
+                      plan->at(x + dx, y + dy) != PlanCell::kOutside)
               << "free cell " << x << "," << y << " at " << plan->CellCenter(x, y).transpose()
               << " touches the outside";
     }

@@ -207,8 +207,8 @@ FloorPlan SmallPlan() {
   plan.resolution_m = 1.f;
   plan.width = 4;
   plan.height = 2;
-  plan.cells = {FloorCell::kFree, FloorCell::kFree, FloorCell::kObstacle, FloorCell::kOutside,
-                FloorCell::kFree, FloorCell::kFree, FloorCell::kFree,     FloorCell::kFree};
+  plan.cells = {PlanCell::kFree, PlanCell::kFree, PlanCell::kObstacle, PlanCell::kOutside,
+                PlanCell::kFree, PlanCell::kFree, PlanCell::kFree,     PlanCell::kFree};
   return plan;
 }
 
@@ -242,7 +242,7 @@ TEST(FloorCoverage, CountsKnownFreeCellsAcrossResolutions) {
   observed.cells.pop_back();
   EXPECT_FALSE(FloorCoverage(plan, observed).ok());
   FloorPlan no_free = plan;
-  std::fill(no_free.cells.begin(), no_free.cells.end(), FloorCell::kObstacle);
+  std::fill(no_free.cells.begin(), no_free.cells.end(), PlanCell::kObstacle);
   observed.cells.push_back(1);
   EXPECT_FALSE(FloorCoverage(no_free, observed).ok());
 }

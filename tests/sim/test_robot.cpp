@@ -20,12 +20,12 @@ FloorPlan SquareWithPillar() {
   FloorPlan plan;
   plan.resolution_m = 0.05f;
   plan.width = plan.height = 80;
-  plan.cells.assign(80 * 80, FloorCell::kFree);
+  plan.cells.assign(80 * 80, PlanCell::kFree);
   for (int y = 0; y < 80; ++y)
     for (int x = 0; x < 80; ++x) {
       const bool wall = x == 0 || y == 0 || x == 79 || y == 79;
       const bool pillar = x >= 30 && x < 50 && y >= 30 && y < 50;
-      if (wall || pillar) plan.cells[size_t(y) * 80 + x] = FloorCell::kObstacle;
+      if (wall || pillar) plan.cells[size_t(y) * 80 + x] = PlanCell::kObstacle;
     }
   return plan;
 }

@@ -4,6 +4,7 @@
 
 #include <cmath>
 #include <numbers>
+#include <vector>
 
 #include "core/parallel.h"
 #include "sim/raycaster.h"
@@ -77,6 +78,34 @@ TEST(SensorNoise, AxialSigmaMatchesModelOnPlanes) {
   // The model's own numbers (Nguyen 2012): 1.2 mm at 0.4 m, 1.2 + 1.9 * 2.6^2 mm at 3 m.
   EXPECT_NEAR(AxialSigma({}, 0.4f), 0.0012f, 1e-7f);
   EXPECT_NEAR(AxialSigma({}, 3.0f), 0.0012f + 0.0019f * 2.6f * 2.6f, 1e-6f);
+}
+
+TEST(SensorNoise, AxialErrorsHaveGaussianTails) {
+  // The share of standardised errors beyond k σ against 2 (1 - Φ(k)), over enough frames that
+  // the ziggurat's tail (beyond 3.44 σ) and its wedges are sampled; 5 binomial σ either side.
+  constexpr double kBinomialSigmas = 5.0;
+  const PinholeCamera camera = test::TestCamera(160, 120);
+  const float z = 1.5f;
+  const RenderOutput clean = RenderFrontalPlane(z, camera);
+  const KinectNoiseParams params = Only(true, false, false);
+  const double sigma = AxialSigma(params, z);
+  const std::vector<double> ks = {1.0, 2.0, 3.0, 3.5};
+  std::vector<size_t> beyond(ks.size(), 0);
+  size_t n = 0;
+  for (uint64_t frame = 0; frame < 12; ++frame) {
+    auto noisy = ApplyKinectNoise(clean.depth, clean.normals_C, camera, params, frame);
+    ASSERT_TRUE(noisy.ok());
+    for (size_t i = 0; i < clean.depth.data.size(); ++i) {
+      const double e = std::abs(double(noisy->data[i]) - double(clean.depth.data[i])) / sigma;
+      for (size_t j = 0; j < ks.size(); ++j) beyond[j] += e > ks[j] ? 1 : 0;
+      ++n;
+    }
+  }
+  for (size_t j = 0; j < ks.size(); ++j) {
+    const double p = std::erfc(ks[j] / std::numbers::sqrt2);
+    const double tolerance = kBinomialSigmas * std::sqrt(p * (1.0 - p) / double(n));
+    EXPECT_NEAR(double(beyond[j]) / double(n), p, tolerance) << "beyond " << ks[j] << " sigma";
+  }
 }
 
 TEST(SensorNoise, QuantisedDepthsSitOnDisparitySteps) {

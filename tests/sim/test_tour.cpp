@@ -29,7 +29,7 @@ Layout ThreeRooms(bool closed_room = false) {
   l.plan.resolution_m = res;
   l.plan.width = int(std::lround(width_m / res));
   l.plan.height = int(std::lround(6.f / res));
-  l.plan.cells.assign(size_t(l.plan.width) * l.plan.height, FloorCell::kFree);
+  l.plan.cells.assign(size_t(l.plan.width) * l.plan.height, PlanCell::kFree);
   for (int y = 0; y < l.plan.height; ++y)
     for (int x = 0; x < l.plan.width; ++x) {
       const Eigen::Vector2f c = l.plan.CellCenter(x, y);
@@ -39,7 +39,7 @@ Layout ThreeRooms(bool closed_room = false) {
       wall |= near(c.y(), 3.f) && c.x() < 9.f && !(c.x() > 6.f && c.x() < 7.f);
       wall |= closed_room && near(c.x(), 9.f);
       const bool table = c.x() > 1.5f && c.x() < 2.5f && c.y() > 4.f && c.y() < 5.f;
-      if (wall || table) l.plan.cells[size_t(y) * l.plan.width + x] = FloorCell::kObstacle;
+      if (wall || table) l.plan.cells[size_t(y) * l.plan.width + x] = PlanCell::kObstacle;
     }
   l.rooms = {{"a", Eigen::AlignedBox2f(Eigen::Vector2f(0, 0), Eigen::Vector2f(4, 3))},
              {"b", Eigen::AlignedBox2f(Eigen::Vector2f(4, 0), Eigen::Vector2f(9, 3))},
@@ -52,6 +52,22 @@ Layout ThreeRooms(bool closed_room = false) {
 float HeadingDeg(const Pose3f& T_W_C) {
   const Eigen::Vector3f z = T_W_C.linear().col(2);
   return std::atan2(z.y(), z.x()) * 180.f / std::numbers::pi_v<float>;
+}
+
+// Elevation of the optical axis above the horizontal: the camera's pitch.
+float ElevationDeg(const Pose3f& T_W_C) {
+  return std::asin(std::clamp(T_W_C.linear()(2, 2), -1.f, 1.f)) * 180.f / std::numbers::pi_v<float>;
+}
+
+// Widest gap between the camera headings of `frames`, around the circle (360 when empty).
+float WidestHeadingGapDeg(const std::vector<Pose3f>& frames) {
+  std::vector<float> headings;
+  for (const Pose3f& T : frames) headings.push_back(HeadingDeg(T));
+  if (headings.empty()) return 360.f;
+  std::sort(headings.begin(), headings.end());
+  float gap = 360.f - (headings.back() - headings.front());
+  for (size_t k = 1; k < headings.size(); ++k) gap = std::max(gap, headings[k] - headings[k - 1]);
+  return gap;
 }
 
 float AngleDeg(const Pose3f& a, const Pose3f& b) {
@@ -90,20 +106,68 @@ TEST(Tour, VisitsEveryRoomWithCollisionFreeFrames) {
     const Eigen::Vector2f p = tour->viewpoints_W[size_t(it - tour->viewpoint_room.begin())];
     EXPECT_TRUE(l.rooms[r].footprint_W.contains(p)) << l.rooms[r].name << " " << p.transpose();
   }
-  // A full turn at each viewpoint: camera headings there leave no gap wider than one step.
-  for (const Eigen::Vector2f& v : tour->viewpoints_W) {
-    std::vector<float> headings;
-    for (const Pose3f& T : tour->T_W_C)
-      if ((T.translation().head<2>() - v).norm() < 1e-4f) headings.push_back(HeadingDeg(T));
-    std::sort(headings.begin(), headings.end());
-    ASSERT_GE(headings.size(), size_t(360.f / params.frame_step_deg));
-    float gap = 360.f - (headings.back() - headings.front());
-    for (size_t k = 1; k < headings.size(); ++k) gap = std::max(gap, headings[k] - headings[k - 1]);
-    EXPECT_LE(gap, params.frame_step_deg + kStepTolerance) << v.transpose();
-  }
+  // A full turn at each viewpoint and spin pitch: camera headings there leave no gap wider
+  // than one step.
+  for (const Eigen::Vector2f& v : tour->viewpoints_W)
+    for (const float pitch_deg : params.spin_pitches_deg) {
+      std::vector<Pose3f> frames;
+      for (const Pose3f& T : tour->T_W_C)
+        if ((T.translation().head<2>() - v).norm() < 1e-4f &&
+            std::abs(ElevationDeg(T) - pitch_deg) < kStepTolerance)
+          frames.push_back(T);
+      ASSERT_GE(frames.size(), size_t(360.f / params.frame_step_deg)) << pitch_deg;
+      EXPECT_LE(WidestHeadingGapDeg(frames), params.frame_step_deg + kStepTolerance)
+          << v.transpose() << " at pitch " << pitch_deg;
+    }
   // The path is no detour: well under the 2-opt-free worst case, over the door-to-door minimum.
   EXPECT_GT(tour->length_m, 5.0);
   EXPECT_LT(tour->length_m, 40.0);
+}
+
+TEST(Tour, SpinsAtEachPitchAndDrivesAtTheDrivingPitch) {
+  const Layout l = ThreeRooms();
+  TourParams params;
+  params.frame_step_deg = 15.f;
+  params.camera_pitch_deg = -10.f;
+  params.spin_pitches_deg = {20.f, -35.f};
+  auto tour = PlanTour(l.plan, l.rooms, params);
+  ASSERT_TRUE(tour.ok()) << tour.status().message();
+  ExpectValidFrames(*tour, l.plan, params);
+  auto at_viewpoint = [&](const Pose3f& T) {
+    return std::any_of(
+        tour->viewpoints_W.begin(), tour->viewpoints_W.end(),
+        [&](const Eigen::Vector2f& v) { return (T.translation().head<2>() - v).norm() < 1e-4f; });
+  };
+  for (const Eigen::Vector2f& v : tour->viewpoints_W) {
+    // No level spin was asked for: no full turn at pitch 0.
+    std::vector<Pose3f> level;
+    for (const Pose3f& T : tour->T_W_C)
+      if ((T.translation().head<2>() - v).norm() < 1e-4f && std::abs(ElevationDeg(T)) < 1e-3f)
+        level.push_back(T);
+    EXPECT_GT(WidestHeadingGapDeg(level), 90.f) << v.transpose();
+    for (const float pitch_deg : params.spin_pitches_deg) {
+      std::vector<Pose3f> frames;
+      for (const Pose3f& T : tour->T_W_C)
+        if ((T.translation().head<2>() - v).norm() < 1e-4f &&
+            std::abs(ElevationDeg(T) - pitch_deg) < kStepTolerance)
+          frames.push_back(T);
+      EXPECT_LE(WidestHeadingGapDeg(frames), params.frame_step_deg + kStepTolerance)
+          << v.transpose() << " at pitch " << pitch_deg;
+    }
+  }
+  // Between viewpoints the camera keeps the driving pitch.
+  size_t driving = 0;
+  for (const Pose3f& T : tour->T_W_C) {
+    if (at_viewpoint(T)) continue;
+    ++driving;
+    EXPECT_NEAR(ElevationDeg(T), params.camera_pitch_deg, kStepTolerance);
+  }
+  EXPECT_GT(driving, 10u);
+
+  params.spin_pitches_deg = {};
+  EXPECT_FALSE(PlanTour(l.plan, l.rooms, params).ok());
+  params.spin_pitches_deg = {0.f, params.robot.max_abs_pitch_deg + 1.f};
+  EXPECT_FALSE(PlanTour(l.plan, l.rooms, params).ok());
 }
 
 TEST(Tour, CoverAloneReachesEveryRoomAndIsDeterministic) {

@@ -70,17 +70,17 @@ World BoxRoom() {
   return w;
 }
 
-std::map<FloorCell, int> Count(const FloorPlan& plan) {
-  std::map<FloorCell, int> n;
-  for (FloorCell c : plan.cells) ++n[c];
+std::map<PlanCell, int> Count(const FloorPlan& plan) {
+  std::map<PlanCell, int> n;
+  for (PlanCell c : plan.cells) ++n[c];
   return n;
 }
 
-FloorCell CellAt(const FloorPlan& plan, float x, float y) {
+PlanCell CellAt(const FloorPlan& plan, float x, float y) {
   const int ix = int(std::floor((x - plan.origin_W.x()) / plan.resolution_m));
   const int iy = int(std::floor((y - plan.origin_W.y()) / plan.resolution_m));
   EXPECT_TRUE(plan.Contains(ix, iy)) << x << ", " << y;
-  return plan.Contains(ix, iy) ? plan.at(ix, iy) : FloorCell::kOutside;
+  return plan.Contains(ix, iy) ? plan.at(ix, iy) : PlanCell::kOutside;
 }
 
 TEST(FloorPlan, BoxRoomKnownAnswer) {
@@ -90,16 +90,16 @@ TEST(FloorPlan, BoxRoomKnownAnswer) {
   EXPECT_FLOAT_EQ(plan->resolution_m, 0.05f);
   const auto n = Count(*plan);
   // Free: the 80 x 60 floor cells minus the 20 x 10 under the table top.
-  EXPECT_EQ(n.at(FloorCell::kFree), 80 * 60 - 20 * 10);
+  EXPECT_EQ(n.at(PlanCell::kFree), 80 * 60 - 20 * 10);
   // Obstacles: the table and the two-cell wall ring (84 x 64 - 80 x 60 cells), no cell more:
   // faces on cell borders do not spill into the neighbouring cell.
-  EXPECT_EQ(n.at(FloorCell::kObstacle), 20 * 10 + (84 * 64 - 80 * 60));
-  EXPECT_EQ(CellAt(*plan, 1.5f, 1.25f), FloorCell::kObstacle);   // under the table
-  EXPECT_EQ(CellAt(*plan, 3.25f, 2.25f), FloorCell::kFree);      // low box below the band
-  EXPECT_EQ(CellAt(*plan, 0.75f, 0.75f), FloorCell::kFree);      // under the high shelf
-  EXPECT_EQ(CellAt(*plan, -0.05f, 1.5f), FloorCell::kObstacle);  // wall core
-  EXPECT_EQ(CellAt(*plan, 0.02f, 1.5f), FloorCell::kFree);       // against the wall
-  EXPECT_EQ(CellAt(*plan, -0.12f, 1.5f), FloorCell::kOutside);   // outside the wall
+  EXPECT_EQ(n.at(PlanCell::kObstacle), 20 * 10 + (84 * 64 - 80 * 60));
+  EXPECT_EQ(CellAt(*plan, 1.5f, 1.25f), PlanCell::kObstacle);   // under the table
+  EXPECT_EQ(CellAt(*plan, 3.25f, 2.25f), PlanCell::kFree);      // low box below the band
+  EXPECT_EQ(CellAt(*plan, 0.75f, 0.75f), PlanCell::kFree);      // under the high shelf
+  EXPECT_EQ(CellAt(*plan, -0.05f, 1.5f), PlanCell::kObstacle);  // wall core
+  EXPECT_EQ(CellAt(*plan, 0.02f, 1.5f), PlanCell::kFree);       // against the wall
+  EXPECT_EQ(CellAt(*plan, -0.12f, 1.5f), PlanCell::kOutside);   // outside the wall
 
   // Without filling solids the wall cores, which no face in the band crosses, read as free (the
   // walls' bottom faces are floor-like): what fill_solids is for.
@@ -107,8 +107,8 @@ TEST(FloorPlan, BoxRoomKnownAnswer) {
   no_fill.fill_solids = false;
   Result<FloorPlan> open = RasterizeFloorPlan(w, no_fill);
   ASSERT_TRUE(open.ok());
-  EXPECT_EQ(Count(*open).at(FloorCell::kFree), 80 * 60 - 20 * 10 + (84 * 64 - 80 * 60));
-  EXPECT_EQ(CellAt(*open, -0.05f, 1.5f), FloorCell::kFree);
+  EXPECT_EQ(Count(*open).at(PlanCell::kFree), 80 * 60 - 20 * 10 + (84 * 64 - 80 * 60));
+  EXPECT_EQ(CellAt(*open, -0.05f, 1.5f), PlanCell::kFree);
 
   // A coarser, misaligned grid is conservative: every cell the table touches is an obstacle.
   FloorPlanParams coarse;
@@ -117,7 +117,7 @@ TEST(FloorPlan, BoxRoomKnownAnswer) {
   ASSERT_TRUE(c.ok());
   for (float x = 1.0f; x <= 2.0f; x += 0.01f)
     for (float y = 1.0f; y <= 1.5f; y += 0.01f)
-      ASSERT_EQ(CellAt(*c, x, y), FloorCell::kObstacle) << x << ", " << y;
+      ASSERT_EQ(CellAt(*c, x, y), PlanCell::kObstacle) << x << ", " << y;
 }
 
 TEST(FloorPlan, SlantedAndDiagonalGeometry) {
@@ -150,14 +150,14 @@ TEST(FloorPlan, SlantedAndDiagonalGeometry) {
   ASSERT_TRUE(plan.ok()) << plan.status().message();
   for (float t = 0.0f; t <= 1.0f; t += 0.002f) {
     const Eigen::Vector2f p = Eigen::Vector2f(0.5f, 0.5f) + t * Eigen::Vector2f(3.0f, 2.0f);
-    ASSERT_EQ(CellAt(*plan, p.x(), p.y()), FloorCell::kObstacle) << p.transpose();
+    ASSERT_EQ(CellAt(*plan, p.x(), p.y()), PlanCell::kObstacle) << p.transpose();
   }
-  EXPECT_EQ(CellAt(*plan, 2.0f, 0.5f), FloorCell::kFree);
-  EXPECT_EQ(CellAt(*plan, 0.05f, 3.5f), FloorCell::kFree);     // ramp below the band
-  EXPECT_EQ(CellAt(*plan, 1.0f, 3.5f), FloorCell::kObstacle);  // ramp in the band
-  EXPECT_EQ(CellAt(*plan, 1.77f, 3.5f), FloorCell::kObstacle);
-  EXPECT_EQ(CellAt(*plan, 1.87f, 3.5f), FloorCell::kFree);  // ramp above the band
-  EXPECT_EQ(CellAt(*plan, 3.0f, 3.5f), FloorCell::kFree);
+  EXPECT_EQ(CellAt(*plan, 2.0f, 0.5f), PlanCell::kFree);
+  EXPECT_EQ(CellAt(*plan, 0.05f, 3.5f), PlanCell::kFree);     // ramp below the band
+  EXPECT_EQ(CellAt(*plan, 1.0f, 3.5f), PlanCell::kObstacle);  // ramp in the band
+  EXPECT_EQ(CellAt(*plan, 1.77f, 3.5f), PlanCell::kObstacle);
+  EXPECT_EQ(CellAt(*plan, 1.87f, 3.5f), PlanCell::kFree);  // ramp above the band
+  EXPECT_EQ(CellAt(*plan, 3.0f, 3.5f), PlanCell::kFree);
 }
 
 TEST(FloorPlan, RefusesBadParams) {
@@ -223,15 +223,15 @@ TEST(LoadWorld, AwsSmallHouseFloorPlan) {
   Result<FloorPlan> plan = RasterizeFloorPlan(w.value());
   ASSERT_TRUE(plan.ok()) << plan.status().message();
   const auto n = Count(*plan);
-  const double free_m2 = n.at(FloorCell::kFree) * 0.05 * 0.05;
+  const double free_m2 = n.at(PlanCell::kFree) * 0.05 * 0.05;
   EXPECT_GT(free_m2, 120.0);
   EXPECT_LT(free_m2, 190.0);
-  EXPECT_EQ(CellAt(*plan, -6.2f, 2.0f), FloorCell::kObstacle);  // the bed
-  EXPECT_EQ(CellAt(*plan, 0.3f, 0.5f), FloorCell::kFree);       // the living room
-  EXPECT_EQ(CellAt(*plan, 6.5f, 0.95f), FloorCell::kObstacle);  // the kitchen table
-  EXPECT_EQ(CellAt(*plan, -8.0f, 5.0f), FloorCell::kOutside);   // beside the north wing
-  EXPECT_EQ(CellAt(*plan, 8.0f, 5.0f), FloorCell::kOutside);
-  EXPECT_EQ(CellAt(*plan, 0.0f, 5.62f), FloorCell::kObstacle);  // north wall
+  EXPECT_EQ(CellAt(*plan, -6.2f, 2.0f), PlanCell::kObstacle);  // the bed
+  EXPECT_EQ(CellAt(*plan, 0.3f, 0.5f), PlanCell::kFree);       // the living room
+  EXPECT_EQ(CellAt(*plan, 6.5f, 0.95f), PlanCell::kObstacle);  // the kitchen table
+  EXPECT_EQ(CellAt(*plan, -8.0f, 5.0f), PlanCell::kOutside);   // beside the north wing
+  EXPECT_EQ(CellAt(*plan, 8.0f, 5.0f), PlanCell::kOutside);
+  EXPECT_EQ(CellAt(*plan, 0.0f, 5.62f), PlanCell::kObstacle);  // north wall
 }
 
 TEST(LoadWorld, RoundTripThroughWriteWorld) {
