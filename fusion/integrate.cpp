@@ -107,37 +107,65 @@ int CarveTileSide(const PinholeCamera& camera, const IntegrateParams& params,
   return std::clamp(int(side), 1, 64);
 }
 
-// Keys in, sorted blocks out.
-std::vector<BlockIndex> SortedBlocks(std::vector<uint64_t>& keys) {
-  std::sort(keys.begin(), keys.end());
-  keys.erase(std::unique(keys.begin(), keys.end()), keys.end());
-  std::vector<BlockIndex> blocks(keys.size());
-  std::transform(keys.begin(), keys.end(), blocks.begin(), UnpackBlockIndex);
-  std::sort(blocks.begin(), blocks.end());
+// Block keys whose integer order is BlockIndex order (z, then y, then x): one sort of the keys
+// gives the sorted blocks. Coordinates are offset into [1, 2^21) (InPackRange).
+constexpr int32_t kKeyOffset = 1 << 20;
+constexpr uint64_t OrderedKey(BlockIndex b) {
+  return (uint64_t(b.z + kKeyOffset) << 42) | (uint64_t(b.y + kKeyOffset) << 21) |
+         uint64_t(b.x + kKeyOffset);
+}
+constexpr BlockIndex FromOrderedKey(uint64_t k) {
+  constexpr uint64_t m = (uint64_t(1) << 21) - 1;
+  return {int32_t(k & m) - kKeyOffset, int32_t((k >> 21) & m) - kKeyOffset,
+          int32_t(k >> 42) - kKeyOffset};
+}
+
+// Sorted runs of keys in (one per task, without duplicates), sorted blocks out. The runs are
+// few (about a few per thread) and their tasks already sorted them, so merging them pairwise
+// here is cheaper than waking the threads again.
+std::vector<BlockIndex> MergeToSortedBlocks(std::vector<std::vector<uint64_t>>& runs) {
+  while (runs.size() > 1) {
+    std::vector<std::vector<uint64_t>> merged((runs.size() + 1) / 2);
+    for (size_t i = 0; i + 1 < runs.size(); i += 2) {
+      const auto& x = runs[i];
+      const auto& y = runs[i + 1];
+      std::vector<uint64_t>& out = merged[i / 2];
+      out.resize(x.size() + y.size());
+      out.erase(std::set_union(x.begin(), x.end(), y.begin(), y.end(), out.begin()), out.end());
+    }
+    if (runs.size() % 2) merged.back() = std::move(runs.back());
+    runs = std::move(merged);
+  }
+  std::vector<BlockIndex> blocks;
+  if (runs.empty()) return blocks;
+  blocks.resize(runs[0].size());
+  std::transform(runs[0].begin(), runs[0].end(), blocks.begin(), FromOrderedKey);
   return blocks;
 }
 
-// Per-task key collection: neighbouring rays hit the same blocks, so a small direct-mapped
-// cache drops most repeats before the global sort.
+// Per-task key collection: neighbouring rays hit the same blocks, so a direct-mapped cache
+// drops most repeats; the task then sorts its keys into a run for MergeToSortedBlocks.
 class KeyCollector {
  public:
   KeyCollector() : cache_(size_t(1) << kCacheBits, ~0ull) {}
   void Add(BlockIndex block) {
     if (!InPackRange(block)) return;
-    const uint64_t key = PackBlockIndex(block);
+    const uint64_t key = OrderedKey(block);
     // Fibonacci hashing: the top bits of key * 2^64/phi spread neighbouring blocks apart.
     uint64_t& slot = cache_[(key * 0x9E3779B97F4A7C15ull) >> (64 - kCacheBits)];
     if (slot == key) return;
     slot = key;
     keys_.push_back(key);
   }
-  void MoveInto(std::vector<uint64_t>& keys, std::mutex& mutex) {
+  void MoveInto(std::vector<std::vector<uint64_t>>& runs, std::mutex& mutex) {
+    std::sort(keys_.begin(), keys_.end());
+    keys_.erase(std::unique(keys_.begin(), keys_.end()), keys_.end());
     std::lock_guard<std::mutex> lock(mutex);
-    keys.insert(keys.end(), keys_.begin(), keys_.end());
+    runs.push_back(std::move(keys_));
   }
 
  private:
-  static constexpr int kCacheBits = 10;
+  static constexpr int kCacheBits = 12;  // 32 KiB: fits the L1/L2 cache
   std::vector<uint64_t> cache_;
   std::vector<uint64_t> keys_;
 };
@@ -145,7 +173,8 @@ class KeyCollector {
 // The band of every valid pixel, or with `carve` everything from min depth through the band.
 std::vector<BlockIndex> CollectBlocks(const DepthImage& depth, const PinholeCamera& camera,
                                       const Pose3f& T_W_C, const IntegrateParams& params,
-                                      const VolumeParams& volume_params, bool carve) {
+                                      const VolumeParams& volume_params, bool carve,
+                                      size_t* valid_pixels = nullptr) {
   const float trunc = volume_params.trunc_m;
   const float inv_block = 1.0f / (volume_params.voxel_size_m * kBlockSide);
   // Work in block units: a pixel's ray is dir(u, v) * z + origin, with dir linear in u and v.
@@ -155,8 +184,8 @@ std::vector<BlockIndex> CollectBlocks(const DepthImage& depth, const PinholeCame
   const Eigen::Vector3f dv_b = R_b.col(1) / camera.fy;
   const Eigen::Vector3f d0_b = R_b.col(2) - du_b * camera.cx - dv_b * camera.cy;
 
-  std::vector<uint64_t> keys;
-  std::mutex keys_mutex;
+  std::vector<std::vector<uint64_t>> runs;
+  std::mutex runs_mutex;
   if (carve) {
     // Carving: square pixel tiles small enough that rays through neighbouring tile corners
     // are at most carve_ray_spacing_blocks apart at max depth, so the pencil of pixel rays
@@ -210,49 +239,68 @@ std::vector<BlockIndex> CollectBlocks(const DepthImage& depth, const PinholeCame
                                 add);
         }
       }
-      collector.MoveInto(keys, keys_mutex);
+      collector.MoveInto(runs, runs_mutex);
     });
-    return SortedBlocks(keys);
+    return MergeToSortedBlocks(runs);
   }
 
+  // Per row, a filter (exact, SIMD where available) keeps the pixels whose band end blocks
+  // differ from their left neighbour's; only those walk their band.
+  const auto candidates = ResolveKernel(params.kernel) == Kernel::kSimd
+                              ? internal::BandRowCandidatesSimd
+                              : internal::BandRowCandidatesScalar;
   constexpr size_t kRowsPerTask = 8;
   const size_t tasks = (size_t(depth.height) + kRowsPerTask - 1) / kRowsPerTask;
   ParallelFor(tasks, 1, [&](size_t begin, size_t end) {
     KeyCollector collector;
     auto add = [&](BlockIndex b) { collector.Add(b); };
+    std::vector<internal::BandCandidate> kept(size_t(depth.width));
+    size_t task_valid = 0;
+    internal::BandRow row;
+    row.width = depth.width;
+    row.trunc_m = trunc;
+    row.min_depth_m = params.min_depth_m;
+    row.max_depth_m = params.max_depth_m;
+    for (int k = 0; k < 3; ++k) {
+      row.du[k] = du_b[k];
+      row.origin[k] = origin_b[k];
+    }
     for (size_t task = begin; task < end; ++task) {
       const int v_end = std::min<int>(depth.height, int((task + 1) * kRowsPerTask));
       for (int v = int(task * kRowsPerTask); v < v_end; ++v) {
         const Eigen::Vector3f row_b = d0_b + dv_b * float(v);
-        const float* depth_row = &depth.data[size_t(v) * size_t(depth.width)];
+        for (int k = 0; k < 3; ++k) row.row[k] = row_b[k];
+        row.depth = &depth.data[size_t(v) * size_t(depth.width)];
+        const int n = candidates(row, kept.data(), &task_valid);
         BlockIndex prev_a{kMaxBlockCoord + 1, 0, 0}, prev_b = prev_a;
-        for (int u = 0; u < depth.width; ++u) {
-          const float d = depth_row[u];
-          if (!(d >= params.min_depth_m && d <= params.max_depth_m)) continue;
-          const Eigen::Vector3f dir_b = row_b + du_b * float(u);
-          const Eigen::Vector3f a = dir_b * std::max(d - trunc, 1e-3f) + origin_b;
-          const Eigen::Vector3f b = dir_b * (d + trunc) + origin_b;
-          const BlockIndex ba{FloorToInt(a.x()), FloorToInt(a.y()), FloorToInt(a.z())};
-          const BlockIndex bb{FloorToInt(b.x()), FloorToInt(b.y()), FloorToInt(b.z())};
-          // Neighbouring pixels mostly start and end in the same blocks as the previous one.
+        for (int i = 0; i < n; ++i) {
+          const internal::BandCandidate& c = kept[size_t(i)];
+          const BlockIndex ba{FloorToInt(c.a[0]), FloorToInt(c.a[1]), FloorToInt(c.a[2])};
+          const BlockIndex bb{FloorToInt(c.b[0]), FloorToInt(c.b[1]), FloorToInt(c.b[2])};
+          // Candidates apart may still start and end in the same blocks as the previous one.
           if (ba == prev_a && bb == prev_b) continue;
           prev_a = ba;
           prev_b = bb;
-          // The band is one block long: mostly it stays in one block or crosses one face, and
-          // then the traversal is exactly {ba, bb} without stepping through it.
+          // The band is about a block long at 1 cm voxels: mostly it stays in one block or
+          // crosses one face, and then the traversal is exactly {ba, bb} without stepping.
           const int steps = std::abs(ba.x - bb.x) + std::abs(ba.y - bb.y) + std::abs(ba.z - bb.z);
           if (steps <= 1) {
             add(ba);
             if (steps == 1) add(bb);
           } else {
-            ForEachBlockOnSegment(a, b, 1.0f, add);
+            ForEachBlockOnSegment(Eigen::Vector3f(c.a[0], c.a[1], c.a[2]),
+                                  Eigen::Vector3f(c.b[0], c.b[1], c.b[2]), 1.0f, add);
           }
         }
       }
     }
-    collector.MoveInto(keys, keys_mutex);
+    if (valid_pixels) {
+      std::lock_guard<std::mutex> lock(runs_mutex);
+      *valid_pixels += task_valid;
+    }
+    collector.MoveInto(runs, runs_mutex);
   });
-  return SortedBlocks(keys);
+  return MergeToSortedBlocks(runs);
 }
 
 }  // namespace
@@ -284,12 +332,20 @@ Result<IntegrateStats> IntegrateFrame(const DepthImage& depth, const ColorImage&
 
   IntegrateStats stats;
   auto t0 = std::chrono::steady_clock::now();
-  std::vector<BlockIndex> band = BlocksToUpdate(depth, camera, T_W_C, params, volume.params());
+  size_t valid_pixels = 0;
+  std::vector<BlockIndex> band =
+      CollectBlocks(depth, camera, T_W_C, params, volume.params(), params.carve_free_space,
+                    params.carve_free_space ? nullptr : &valid_pixels);
+  // Look the blocks up in parallel (concurrent finds are safe); only the missing ones are
+  // allocated, serially, in band order.
   std::vector<TsdfBlock*> blocks(band.size());
+  ParallelFor(band.size(), 1024, [&](size_t begin, size_t end) {
+    for (size_t i = begin; i < end; ++i) blocks[i] = volume.FindBlock(band[i]);
+  });
   for (size_t i = 0; i < band.size(); ++i) {
-    bool created = false;
-    blocks[i] = &volume.FindOrAllocate(band[i], &created);
-    stats.blocks_allocated += created ? 1 : 0;
+    if (blocks[i]) continue;
+    blocks[i] = &volume.FindOrAllocate(band[i]);
+    ++stats.blocks_allocated;
   }
   stats.blocks_in_band = band.size();
   stats.allocate_ms = MsSince(t0);
@@ -324,11 +380,14 @@ Result<IntegrateStats> IntegrateFrame(const DepthImage& depth, const ColorImage&
     for (size_t i = begin; i < end; ++i) kernel(f, band[i], *blocks[i]);
   });
   stats.update_ms = MsSince(t0);
-  // Branch-free, so it vectorises.
-  uint32_t valid = 0;
-  for (float d : depth.data)
-    valid += uint32_t(d >= params.min_depth_m) & uint32_t(d <= params.max_depth_m);
-  stats.valid_pixels = valid;
+  if (params.carve_free_space) {
+    // Branch-free, so it vectorises.
+    uint32_t valid = 0;
+    for (float d : depth.data)
+      valid += uint32_t(d >= params.min_depth_m) & uint32_t(d <= params.max_depth_m);
+    valid_pixels = valid;
+  }
+  stats.valid_pixels = valid_pixels;
   stats.touched_blocks = std::move(band);
   return stats;
 }

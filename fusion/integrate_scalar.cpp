@@ -56,4 +56,27 @@ void IntegrateBlockScalar(const FrameView& f, BlockIndex index, TsdfBlock& block
   }
 }
 
+int BandRowCandidatesScalar(const BandRow& r, BandCandidate* out, size_t* valid_count) {
+  int n = 0;
+  size_t valid_pixels = 0;
+  bool prev_valid = false;
+  BlockIndex prev_a, prev_b;
+  for (int u = 0; u < r.width; ++u) {
+    const float d = r.depth[u];
+    const bool valid = d >= r.min_depth_m && d <= r.max_depth_m;
+    if (valid) {
+      ++valid_pixels;
+      const BandCandidate c = BandEnds(r, u, d);
+      const BlockIndex a{FloorToInt(c.a[0]), FloorToInt(c.a[1]), FloorToInt(c.a[2])};
+      const BlockIndex b{FloorToInt(c.b[0]), FloorToInt(c.b[1]), FloorToInt(c.b[2])};
+      if (!(prev_valid && a == prev_a && b == prev_b)) out[n++] = c;
+      prev_a = a;
+      prev_b = b;
+    }
+    prev_valid = valid;
+  }
+  *valid_count += valid_pixels;
+  return n;
+}
+
 }  // namespace voxplan::internal

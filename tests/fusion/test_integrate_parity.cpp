@@ -5,9 +5,12 @@
 #include <cmath>
 #include <cstring>
 #include <map>
+#include <random>
+#include <set>
 
 #include "core/parallel.h"
 #include "fusion/integrate.h"
+#include "fusion/integrate_kernel.h"
 #include "fusion/mesh_extract.h"
 #include "tests/support/test_support.h"
 
@@ -29,7 +32,7 @@ Sequence MakeSequence() {
   for (int k = 0; k < 5; ++k) {
     const float a = 0.4f + float(k) * 0.5f;
     const Pose3f T_W_C = LookAt(Eigen::Vector3f(1.4f * std::cos(a), 1.4f * std::sin(a), 0.9f),
-                                      Eigen::Vector3f(0, 0, 0.3f));
+                                Eigen::Vector3f(0, 0, 0.3f));
     DepthImage ds = test::RenderDepth(sphere, seq.cam, T_W_C);
     const DepthImage df = test::RenderDepth(floor, seq.cam, T_W_C);
     ColorImage col(seq.cam.width, seq.cam.height);
@@ -105,6 +108,97 @@ TEST(Parity, OneAndTwoThreadsGiveIdenticalVolumesAndMeshes) {
   ExpectIdentical(one.first, two.first);
   EXPECT_FALSE(one.second.empty());
   EXPECT_EQ(one.second, two.second);
+}
+
+// The band walk's row filter: the SIMD one keeps exactly the pixels the scalar one keeps, on
+// rows of every width (tails included) with invalid, out-of-range and NaN depths.
+TEST(Parity, BandRowFilterScalarAndSimdAgree) {
+  if (!SimdKernelAvailable()) GTEST_SKIP() << "this CPU has no AVX2";
+  std::mt19937 rng(7);
+  std::uniform_real_distribution<float> unit(0.f, 1.f);
+  for (int width : {1, 7, 8, 9, 31, 64, 333}) {
+    for (int trial = 0; trial < 20; ++trial) {
+      std::vector<float> depth(static_cast<size_t>(width));
+      float d = 0.5f + 2.f * unit(rng);
+      for (float& x : depth) {
+        const float r = unit(rng);
+        // Mostly smooth runs (so neighbours share blocks), with jumps and invalid values.
+        if (r < 0.05f) d = 0.5f + 2.f * unit(rng);
+        x = r < 0.08f ? 0.f : (r < 0.1f ? std::nanf("") : (r < 0.12f ? 5.f : d));
+        d += 0.002f * (unit(rng) - 0.5f);
+      }
+      internal::BandRow row;
+      row.depth = depth.data();
+      row.width = width;
+      for (int k = 0; k < 3; ++k) {
+        row.row[k] = 4.f * (unit(rng) - 0.5f);
+        row.du[k] = 0.01f * (unit(rng) - 0.5f);
+        row.origin[k] = 100.f * (unit(rng) - 0.5f);
+      }
+      row.trunc_m = 0.02f + 0.1f * unit(rng);
+      row.min_depth_m = 0.1f;
+      row.max_depth_m = 3.0f;
+      std::vector<internal::BandCandidate> scalar(static_cast<size_t>(width)),
+          simd(static_cast<size_t>(width));
+      size_t valid_scalar = 0, valid_simd = 0;
+      const int n_scalar = internal::BandRowCandidatesScalar(row, scalar.data(), &valid_scalar);
+      const int n_simd = internal::BandRowCandidatesSimd(row, simd.data(), &valid_simd);
+      EXPECT_EQ(valid_scalar, valid_simd);
+      // The SIMD filter may keep a few more pixels in the row's last (width % 8) ones; the
+      // band walk drops those again, so compare the kept pixels up to there.
+      const int full = width - width % 8;
+      scalar.resize(size_t(n_scalar));
+      simd.resize(size_t(n_simd));
+      auto in_tail = [&](const internal::BandCandidate& c) { return c.u >= full; };
+      std::erase_if(scalar, in_tail);
+      std::erase_if(simd, in_tail);
+      ASSERT_EQ(scalar.size(), simd.size()) << "width " << width << ", trial " << trial;
+      for (size_t i = 0; i < scalar.size(); ++i) {
+        EXPECT_EQ(scalar[i].u, simd[i].u);
+        EXPECT_EQ(std::memcmp(scalar[i].a, simd[i].a, sizeof(scalar[i].a)), 0);
+        EXPECT_EQ(std::memcmp(scalar[i].b, simd[i].b, sizeof(scalar[i].b)), 0);
+      }
+    }
+  }
+}
+
+// The blocks of the truncation band are the same with either filter, and hold the end blocks
+// of the valid pixels' bands.
+TEST(Parity, TruncationBandIsTheSameWithEitherFilter) {
+  if (!SimdKernelAvailable()) GTEST_SKIP() << "this CPU has no AVX2";
+  const Sequence seq = MakeSequence();
+  const VolumeParams volume_params{0.02f, 0.08f};
+  for (size_t f = 0; f < seq.poses.size(); ++f) {
+    IntegrateParams params;
+    params.kernel = Kernel::kScalar;
+    const auto scalar =
+        BlocksInTruncationBand(seq.depth[f], seq.cam, seq.poses[f], params, volume_params);
+    params.kernel = Kernel::kSimd;
+    const auto simd =
+        BlocksInTruncationBand(seq.depth[f], seq.cam, seq.poses[f], params, volume_params);
+    ASSERT_EQ(scalar, simd) << "frame " << f;
+    ASSERT_TRUE(std::is_sorted(simd.begin(), simd.end()));
+    ASSERT_EQ(std::adjacent_find(simd.begin(), simd.end()), simd.end());
+    // Both ends of every valid pixel's band, computed independently (rounding may put a
+    // point on the other side of a block face now and then).
+    const std::set<BlockIndex> band(simd.begin(), simd.end());
+    const float block = volume_params.voxel_size_m * kBlockSide;
+    size_t missing = 0, checked = 0;
+    for (int v = 0; v < seq.cam.height; ++v) {
+      for (int u = 0; u < seq.cam.width; ++u) {
+        const float d = seq.depth[f].at(u, v);
+        if (!(d >= params.min_depth_m && d <= params.max_depth_m)) continue;
+        const Eigen::Vector3f ray((float(u) - seq.cam.cx) / seq.cam.fx,
+                                  (float(v) - seq.cam.cy) / seq.cam.fy, 1.f);
+        for (float z : {d - volume_params.trunc_m, d + volume_params.trunc_m}) {
+          missing += !band.count(BlockAt(seq.poses[f] * (ray * z), block));
+          ++checked;
+        }
+      }
+    }
+    EXPECT_GT(checked, 1000u);
+    EXPECT_LE(missing, checked / 1000) << "frame " << f;
+  }
 }
 
 // The same projective update in float and double, without quantisation: the compact encoding
