@@ -6,19 +6,28 @@
 
 namespace voxplan::planners {
 
-BaselineWorld ReadBaselineWorld(const vp::WorldView& world, const CommonOptions& options) {
+BaselineWorld ReadBaselineWorld(const vp::WorldView& world, const CommonOptions& options,
+                                SettledCells* settled) {
   BaselineWorld b;
   b.input = ReadWorld(world, options);
   if (b.input.robots.empty()) return b;
+  settled->Apply(world, PassOptions(options, b.input), &b.input);
+  ReadHostReach(world, &b.input);
   omt::ViewSet set = omt::ExtractAccessibleViews(b.input.raster, b.input.clearance, b.input.states,
-                                                 PassOptions(options, b.input));
+                                                 PassOptions(options, b.input), &b.input.accessible,
+                                                 b.input.anchored_robots);
   b.views = std::move(set.views);
-  for (size_t r = 0; r < b.input.robots.size(); ++r) b.anchored_robots += set.anchors[r].node >= 0;
+  b.anchored_robots = set.anchored_robots;
   for (const omt::TaskView& v : b.views) {
     b.important.push_back(v.importance > options.omt.importance_threshold ? 1 : 0);
   }
-  for (const vp_robot& robot : b.input.robots) {
-    b.robot_view_m.push_back(DistancesToViews(world, b, robot.x_m, robot.y_m));
+  for (const std::vector<float>& field : b.input.robot_fields) {
+    b.robot_view_m.emplace_back();
+    for (const omt::TaskView& v : b.views) {
+      b.robot_view_m.back().push_back(v.cell >= 0 && size_t(v.cell) < field.size()
+                                          ? field[size_t(v.cell)]
+                                          : std::numeric_limits<float>::infinity());
+    }
     for (size_t v = 0; v < b.views.size(); ++v) {
       if (b.important[v] && std::isfinite(b.robot_view_m.back()[v])) {
         b.any_important_reachable = true;

@@ -24,7 +24,9 @@ struct BaselineWorld {
   // No view worth it is left for anyone; false while no robot could be judged at all.
   bool Done() const { return !any_important_reachable && anchored_robots > 0; }
 };
-BaselineWorld ReadBaselineWorld(const vp::WorldView& world, const CommonOptions& options);
+// settled: the planner's memory of cells looked at in vain (updated here).
+BaselineWorld ReadBaselineWorld(const vp::WorldView& world, const CommonOptions& options,
+                                SettledCells* settled);
 
 // Host geodesic distance from a point to every view (+inf when unreachable).
 std::vector<float> DistancesToViews(const vp::WorldView& world, const BaselineWorld& b, float x_m,

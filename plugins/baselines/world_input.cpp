@@ -99,6 +99,7 @@ CommonOptions ReadCommonOptions(JsonOptions& json) {
   o.omt.views.uncertainty.weight_scale =
       json.Number("weight_scale", o.omt.views.uncertainty.weight_scale, 1e-6, 1e9);
   o.geodesics = json.Choice("geodesics", o.geodesics, {"host", "internal"});
+  o.fov_from_robot = json.Flag("fov_from_robot", o.fov_from_robot);
   return o;
 }
 
@@ -139,7 +140,10 @@ WorldInput ReadWorld(const vp::WorldView& world, const CommonOptions& options) {
   std::vector<double> weight_sum(n, 0.0);
   std::vector<uint32_t> weight_count(n, 0);
   const float min_z = in.map.floor_z_m + float(options.surface_min_height_m);
-  for (const vp_surface_voxel& s : world.SurfaceVoxels()) {
+  const double surface_start_s = world.ElapsedS();
+  const std::span<const vp_surface_voxel> surface = world.SurfaceVoxels();
+  in.surface_voxels_ms = (world.ElapsedS() - surface_start_s) * 1e3;
+  for (const vp_surface_voxel& s : surface) {
     if (!(s.position[2] >= min_z) || !std::isfinite(s.weight)) continue;
     const auto [ix, iy] = floor.CellOf(s.position[0], s.position[1]);
     if (!floor.Contains(ix, iy)) continue;
@@ -160,8 +164,15 @@ WorldInput ReadWorld(const vp::WorldView& world, const CommonOptions& options) {
     state.position_m = {robot.x_m, robot.y_m};
     state.yaw_rad = omt::WrapAngle(double(robot.theta_rad) + robot.camera_yaw_rad);
     if (robot.mode >= 0 && uint32_t(robot.mode) < robot.mode_count) {
-      const float speed = world.Mode(r, uint32_t(robot.mode)).max_speed_mps;
-      if (std::isfinite(speed) && speed > 0.f) state.speed_mps = speed;
+      const vp_mode_params mode = world.Mode(r, uint32_t(robot.mode));
+      if (std::isfinite(mode.max_speed_mps) && mode.max_speed_mps > 0.f) {
+        state.speed_mps = mode.max_speed_mps;
+      }
+      if (std::isfinite(mode.horizontal_fov_rad) && mode.horizontal_fov_rad > 0.f &&
+          mode.horizontal_fov_rad < float(2.0 * omt::kPi)) {
+        in.fov_rad = in.fov_rad > 0.0 ? std::min(in.fov_rad, double(mode.horizontal_fov_rad))
+                                      : double(mode.horizontal_fov_rad);
+      }
     }
     max_radius_m = std::max(max_radius_m, robot.radius_m);
     in.robots.push_back(robot);
@@ -186,9 +197,91 @@ WorldInput ReadWorld(const vp::WorldView& world, const CommonOptions& options) {
   return in;
 }
 
+void ReadHostReach(const vp::WorldView& world, WorldInput* input) {
+  const size_t n = input->raster.cells.size();
+  input->accessible.assign(n, 0);
+  input->robot_fields.clear();
+  input->anchored_robots = 0;
+  for (const vp_robot& robot : input->robots) {
+    const std::span<const float> field =
+        world.GeodesicField(robot.x_m, robot.y_m, input->min_clearance_m);
+    std::vector<float> copy(field.begin(), field.end());
+    copy.resize(n, std::numeric_limits<float>::infinity());
+    bool any = false;
+    for (size_t i = 0; i < n; ++i) {
+      if (!std::isfinite(copy[i])) continue;
+      input->accessible[i] = 1;
+      any = true;
+    }
+    input->anchored_robots += any;
+    input->robot_fields.push_back(std::move(copy));
+  }
+}
+
+void SettledCells::Update(const vp::WorldView& world, const WorldInput& input,
+                          const omt::SensorParams& sensor,
+                          const omt::UncertaintyParams& uncertainty) {
+  const omt::OccupancyRaster& raster = input.raster;
+  const omt::RasterGeometry& g = raster.geometry;
+  if (g.NumCells() == 0) return;
+  auto key = [&](int cell) {
+    const Eigen::Vector2d c = g.Center(cell) / g.resolution_m;
+    return std::make_pair(long(std::floor(c.x())), long(std::floor(c.y())));
+  };
+  // Rays half a cell apart at the far range reach every cell of the fan.
+  const double step = 0.5 * g.resolution_m / sensor.d_max_m;
+  const int rays = std::max(1, int(std::ceil(sensor.fov_rad / step)));
+  for (size_t r = 0; r < input.robots.size(); ++r) {
+    if (input.robots[r].status != VP_ROBOT_IDLE) continue;
+    if (world.event() == VP_EVENT_TASK_FAILED && world.call().event_robot == int32_t(r)) continue;
+    const Eigen::Vector2d p = input.states[r].position_m;
+    const int start = g.IndexOf(p);
+    for (int k = 0; k <= rays; ++k) {
+      const double yaw = input.states[r].yaw_rad - 0.5 * sensor.fov_rad + sensor.fov_rad * k / rays;
+      const Eigen::Vector2d dir(std::cos(yaw), std::sin(yaw));
+      omt::TraverseRay(g, p, dir, sensor.d_max_m, [&](int cell, double) {
+        if (cell == start) return true;
+        const omt::Cell c = raster.At(cell);
+        const double d = (g.Center(cell) - p).norm();
+        if (c == omt::Cell::kFree) return true;
+        const bool in_range = d >= sensor.d_min_m && d <= sensor.d_max_m;
+        if (c == omt::Cell::kOccupied) {
+          const double u = omt::CellUncertainty(c, raster.WeightAt(cell), uncertainty);
+          // A surface gains weight with every look; only one that stays unscanned is settled.
+          if (in_range && u >= uncertainty.unknown_uncertainty) cells_.insert(key(cell));
+          return false;
+        }
+        if (in_range) cells_.insert(key(cell));
+        return true;
+      });
+    }
+  }
+}
+
+void SettledCells::Apply(const vp::WorldView& world, const omt::PlannerOptions& options,
+                         WorldInput* input) {
+  Update(world, *input, options.views.sensor, options.views.uncertainty);
+  input->raster.settled = Mask(input->raster.geometry);
+}
+
+std::vector<uint8_t> SettledCells::Mask(const omt::RasterGeometry& g) const {
+  std::vector<uint8_t> mask;
+  if (cells_.empty()) return mask;
+  mask.assign(size_t(g.NumCells()), 0);
+  const long x0 = long(std::lround(g.origin_m.x() / g.resolution_m));
+  const long y0 = long(std::lround(g.origin_m.y() / g.resolution_m));
+  for (const auto& [x, y] : cells_) {
+    const long ix = x - x0, iy = y - y0;
+    if (ix >= 0 && iy >= 0 && ix < g.width && iy < g.height)
+      mask[size_t(g.Index(int(ix), int(iy)))] = 1;
+  }
+  return mask;
+}
+
 omt::PlannerOptions PassOptions(const CommonOptions& options, const WorldInput& input) {
   omt::PlannerOptions o = options.omt;
   o.robot_radius_m = input.robot_radius_m;
+  if (options.fov_from_robot && input.fov_rad > 0.0) o.views.sensor.fov_rad = input.fov_rad;
   return o;
 }
 

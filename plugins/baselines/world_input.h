@@ -49,6 +49,9 @@ struct CommonOptions {
   // Geodesics of the omt pass: "host" (distance_matrix / shortest_path, the distances the host
   // validates with) or "internal" (the algorithms' own coarse grid, faster on big floors).
   std::string geodesics = "host";
+  // Views' field of view: the robots' current scanning mode's (the narrowest) instead of the
+  // paper's 58° Kinect.
+  bool fov_from_robot = false;
 };
 CommonOptions ReadCommonOptions(JsonOptions& json);
 
@@ -63,9 +66,44 @@ struct WorldInput {
   omt::ClearanceRaster clearance;  // the host's: distance to the nearest obstacle cell
   double robot_radius_m = 0.0;     // views, paths and the internal grid keep this
   float min_clearance_m = 0.f;     // for host geodesic queries: robot_radius_m + margin
+  double surface_voxels_ms = 0.0;  // spent in the host's surface voxel query
+  double fov_rad = 0.0;            // narrowest horizontal FOV of the robots' modes; 0: unknown
+  // ReadHostReach: per robot the host's geodesic field (min_clearance_m), the cells any of them
+  // reaches, and how many robots reach any cell (a robot the host cannot place reaches none).
+  std::vector<std::vector<float>> robot_fields;
+  std::vector<uint8_t> accessible;
+  int anchored_robots = 0;
 };
 // vp::Error for a floor raster without cells.
 WorldInput ReadWorld(const vp::WorldView& world, const CommonOptions& options);
+
+// Fills input->robot_fields, accessible and anchored_robots from the host's geodesic fields, the
+// traversability the host validates tasks with (known free cells, 16-connected, snapped robots).
+void ReadHostReach(const vp::WorldView& world, WorldInput* input);
+
+// Cells the robots looked at from their views and the map did not resolve, kept across calls
+// (a planner's state). The floor raster's 2-D model overrates some cells: a column counts as
+// free only once most of its height band is observed, and a level camera with a 3 m depth limit
+// never sees all of it in a long corridor or right in front of the robot. Such a cell would keep
+// a view important forever and the robot would take it again and again; once an idle robot has
+// looked at it (dwelled at its view, captured) and it is still unknown, or a surface still
+// unscanned, it is settled: never queued nor counted again (omt::OccupancyRaster::settled).
+class SettledCells {
+ public:
+  // Adds the unresolved cells of every idle robot's camera fan (between the sensor's near and
+  // far range, up to the first surface on each ray); a robot whose task just failed did not
+  // take its view and adds nothing.
+  void Update(const vp::WorldView& world, const WorldInput& input, const omt::SensorParams& sensor,
+              const omt::UncertaintyParams& uncertainty);
+  // Update, then input->raster.settled = Mask(its geometry).
+  void Apply(const vp::WorldView& world, const omt::PlannerOptions& options, WorldInput* input);
+  // The settled flags over this call's raster (its origin moves as the map grows).
+  std::vector<uint8_t> Mask(const omt::RasterGeometry& g) const;
+  size_t size() const { return cells_.size(); }
+
+ private:
+  std::set<std::pair<long, long>> cells_;  // global cells (floor(x / res), floor(y / res))
+};
 
 // options.omt with this world's robot radius.
 omt::PlannerOptions PassOptions(const CommonOptions& options, const WorldInput& input);

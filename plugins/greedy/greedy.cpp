@@ -25,11 +25,12 @@ class GreedyPlanner : public vp::Planner {
     BaselineWorld b;
     {
       vp::StageTimer timer(world, out, "views");
-      b = ReadBaselineWorld(world, options_);
+      b = ReadBaselineWorld(world, options_, &settled_);
     }
     out.DebugPoints("greedy_views", ViewPointsXyz(b.views, b.input.map.floor_z_m), 0xffa000ffu);
     if (!b.any_important_reachable) {
       ReportViews(out, b, 0);
+      out.Diagnostic("settled_cells", double(settled_.size()));
       out.SetDone(b.Done());
       return;
     }
@@ -59,10 +60,12 @@ class GreedyPlanner : public vp::Planner {
       ++tasks;
     }
     ReportViews(out, b, tasks);
+    out.Diagnostic("settled_cells", double(settled_.size()));
   }
 
  private:
   CommonOptions options_;
+  SettledCells settled_;         // cells looked at in vain, across calls
   double claim_radius_m_ = 0.5;  // a view this close to another robot's queued task is its
 };
 

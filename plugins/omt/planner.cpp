@@ -31,54 +31,90 @@ void ParallelFor(int n, int threads, const std::function<void(int)>& fn) {
 
 }  // namespace
 
-ViewSet ExtractAccessibleViews(const OccupancyRaster& raster, const ClearanceRaster& clearance,
-                               const std::vector<RobotState>& robots,
-                               const PlannerOptions& options) {
+std::vector<std::uint8_t> AccessibleCells(const OccupancyRaster& raster,
+                                          const ClearanceRaster& clearance,
+                                          const std::vector<RobotState>& robots,
+                                          double robot_radius_m, double snap_radius_m,
+                                          int* anchored) {
   const RasterGeometry& g = raster.geometry;
-  const int R = static_cast<int>(robots.size());
-  ViewSet out;
-  // Geodesic grid, robots joined to it, the part of it they can reach.
-  out.grid = BuildGeodesicGrid(clearance, options.geodesic_cell_m, options.robot_radius_m);
-  const GeodesicGrid& grid = out.grid;
-  std::vector<int> sources;
-  for (const RobotState& r : robots) {
-    out.anchors.push_back(AnchorPoint(grid, clearance, r.position_m, options.robot_radius_m));
-    sources.push_back(out.anchors.back().node);
-  }
-  out.reachable = ReachableNodes(grid, sources);
-  const std::vector<std::uint8_t>& reachable = out.reachable;
-  // A fine cell is accessible when a reachable node lies within one grid step; the exact
-  // test (a clear anchor segment) follows per view.
-  std::vector<std::uint8_t> accessible(static_cast<std::size_t>(g.NumCells()), 0);
-  for (int y = 0; y < g.height; ++y) {
-    for (int x = 0; x < g.width; ++x) {
-      const int cx = x / grid.factor;
-      const int cy = y / grid.factor;
-      bool any = false;
-      for (int dy = -1; dy <= 1 && !any; ++dy)
-        for (int dx = -1; dx <= 1 && !any; ++dx) {
-          const int nx = cx + dx;
-          const int ny = cy + dy;
-          any = nx >= 0 && ny >= 0 && nx < grid.width && ny < grid.height &&
-                reachable[static_cast<std::size_t>(ny * grid.width + nx)];
+  const auto n = static_cast<std::size_t>(g.NumCells());
+  std::vector<std::uint8_t> open(n, 0);
+  for (std::size_t i = 0; i < n; ++i)
+    open[i] = raster.cells[i] == Cell::kFree && clearance.clearance_m[i] >= robot_radius_m;
+  std::vector<std::uint8_t> seen(n, 0);
+  std::vector<int> stack;
+  int seeded = 0;
+  const int snap = static_cast<int>(std::ceil(snap_radius_m / g.resolution_m));
+  for (const RobotState& robot : robots) {
+    const Eigen::Vector2d q = (robot.position_m - g.origin_m) / g.resolution_m;
+    const int rx = static_cast<int>(std::floor(q.x()));
+    const int ry = static_cast<int>(std::floor(q.y()));
+    // Its own cell, else the nearest open one within the snap radius (ties: scan order).
+    int seed = -1;
+    double best_d2 = snap_radius_m * snap_radius_m;
+    for (int y = ry - snap; y <= ry + snap; ++y) {
+      for (int x = rx - snap; x <= rx + snap; ++x) {
+        if (!g.InBounds(x, y) || !open[static_cast<std::size_t>(g.Index(x, y))]) continue;
+        const double d2 = (g.Center(x, y) - robot.position_m).squaredNorm();
+        if (x == rx && y == ry) {
+          seed = g.Index(x, y);
+          best_d2 = -1.0;
+        } else if (d2 < best_d2) {
+          seed = g.Index(x, y);
+          best_d2 = d2;
         }
-      accessible[static_cast<std::size_t>(g.Index(x, y))] = any ? 1 : 0;
+      }
+    }
+    if (seed < 0) continue;
+    ++seeded;
+    if (!seen[static_cast<std::size_t>(seed)]) {
+      seen[static_cast<std::size_t>(seed)] = 1;
+      stack.push_back(seed);
     }
   }
+  while (!stack.empty()) {
+    const int u = stack.back();
+    stack.pop_back();
+    const int ux = g.X(u);
+    const int uy = g.Y(u);
+    for (int dy = -1; dy <= 1; ++dy) {
+      for (int dx = -1; dx <= 1; ++dx) {
+        const int vx = ux + dx;
+        const int vy = uy + dy;
+        if ((dx == 0 && dy == 0) || !g.InBounds(vx, vy)) continue;
+        const auto v = static_cast<std::size_t>(g.Index(vx, vy));
+        if (seen[v] || !open[v]) continue;
+        if (dx != 0 && dy != 0 &&
+            (!open[static_cast<std::size_t>(g.Index(vx, uy))] ||
+             !open[static_cast<std::size_t>(g.Index(ux, vy))]))
+          continue;
+        seen[v] = 1;
+        stack.push_back(static_cast<int>(v));
+      }
+    }
+  }
+  if (anchored) *anchored = seeded;
+  return seen;
+}
 
+ViewSet ExtractAccessibleViews(const OccupancyRaster& raster, const ClearanceRaster& clearance,
+                               const std::vector<RobotState>& robots, const PlannerOptions& options,
+                               const std::vector<std::uint8_t>* accessible_cells,
+                               int anchored_robots) {
+  ViewSet out;
+  if (accessible_cells && accessible_cells->size() == raster.cells.size()) {
+    out.accessible = *accessible_cells;
+    out.anchored_robots = anchored_robots;
+  } else {
+    out.accessible = AccessibleCells(raster, clearance, robots, options.robot_radius_m,
+                                     options.snap_radius_m, &out.anchored_robots);
+  }
   // Task views (§3.2), or frontier points for NoTV.
   TaskViewParams view_params = options.views;
-  view_params.max_views = options.kappa * R;
+  view_params.max_views = options.kappa * static_cast<int>(robots.size());
   view_params.robot_radius_m = options.robot_radius_m;
   view_params.frontier_points_only = !options.use_task_views;
-  const std::vector<TaskView> extracted =
-      ExtractTaskViews(raster, clearance, view_params, &accessible);
-  for (const TaskView& v : extracted) {
-    Anchor a = AnchorPoint(grid, clearance, v.position_m, options.robot_radius_m);
-    if (a.node < 0 || !reachable[static_cast<std::size_t>(a.node)]) continue;
-    out.views.push_back(v);
-    out.anchors.push_back(a);
-  }
+  out.views = ExtractTaskViews(raster, clearance, view_params, &out.accessible);
   return out;
 }
 
@@ -91,6 +127,8 @@ Status PlanOmt(const OccupancyRaster& raster, const ClearanceRaster* clearance_i
     return Status::Error(Status::Code::kInvalidInput, "raster size does not match its geometry");
   if (!raster.tsdf_weight.empty() && raster.tsdf_weight.size() != raster.cells.size())
     return Status::Error(Status::Code::kInvalidInput, "tsdf_weight size does not match");
+  if (!raster.settled.empty() && raster.settled.size() != raster.cells.size())
+    return Status::Error(Status::Code::kInvalidInput, "settled size does not match");
   if (robots.empty()) return Status::Error(Status::Code::kInvalidInput, "no robots");
   if (clearance_in && clearance_in->clearance_m.size() != raster.cells.size())
     return Status::Error(Status::Code::kInvalidInput, "clearance size does not match");
@@ -100,12 +138,11 @@ Status PlanOmt(const OccupancyRaster& raster, const ClearanceRaster* clearance_i
   const int R = static_cast<int>(robots.size());
   result->robots.resize(static_cast<std::size_t>(R));
 
-  ViewSet view_set = ExtractAccessibleViews(raster, clearance, robots, options);
-  const GeodesicGrid& grid = view_set.grid;
-  std::vector<Anchor>& anchors = view_set.anchors;
+  const std::vector<std::uint8_t>* given = provider ? provider->accessible_cells : nullptr;
+  ViewSet view_set = ExtractAccessibleViews(raster, clearance, robots, options, given,
+                                            provider ? provider->anchored_robots : 0);
   result->views = std::move(view_set.views);
-  for (int r = 0; r < R; ++r)
-    result->anchored_robots += anchors[static_cast<std::size_t>(r)].node >= 0;
+  result->anchored_robots = view_set.anchored_robots;
   result->terminated = ShouldTerminate(result->views, options.importance_threshold);
   if (result->terminated) return Status::Ok();
   const int K = static_cast<int>(result->views.size());
@@ -119,8 +156,13 @@ Status PlanOmt(const OccupancyRaster& raster, const ClearanceRaster* clearance_i
   };
   const bool external_matrix = provider && provider->distance_matrix;
   const bool external_paths = provider && provider->shortest_path;
+  GeodesicGrid grid;
+  std::vector<Anchor> anchors;  // robots, then views
   std::vector<ShortestPaths> paths(static_cast<std::size_t>(n_nodes));
   if (!external_matrix || !external_paths) {
+    grid = BuildGeodesicGrid(clearance, options.geodesic_cell_m, options.robot_radius_m);
+    for (int i = 0; i < n_nodes; ++i)
+      anchors.push_back(AnchorPoint(grid, clearance, position(i), options.robot_radius_m));
     // Each search stops once every robot and view anchor is settled.
     std::vector<std::uint8_t> wanted(static_cast<std::size_t>(grid.NumNodes()), 0);
     int num_wanted = 0;

@@ -24,7 +24,8 @@ struct RobotState {
 struct PlannerOptions {
   int kappa = 6;  // κ: at most κR task views per pass
   double robot_radius_m = 0.18;
-  double geodesic_cell_m = 0.2;       // node spacing of the geodesic grid
+  double geodesic_cell_m = 0.2;  // node spacing of the internal geodesic grid
+  double snap_radius_m = 0.5;    // a robot off accessible cells starts from the nearest within this
   double importance_threshold = 1.5;  // §4 termination
   TaskViewParams views;  // max_views and robot_radius_m are set from kappa and robot_radius_m
   AssignmentParams assignment;  // refine is set from the flag below
@@ -51,8 +52,9 @@ struct PlanResult {
   Assignment assignment;
   std::vector<RobotPlan> robots;  // one per input robot; empty plan = no task this pass
   bool terminated = false;        // no accessible view with importance above the threshold
-  // Robots joined to the internal geodesic grid. With none, no view can be accessible and
-  // `terminated` says nothing about the scene (e.g. too little known free space around them).
+  // Robots standing on (or within snap_radius_m of) a cell they can move from. With none, no
+  // view can be accessible and `terminated` says nothing about the scene (e.g. too little known
+  // free space around them).
   int anchored_robots = 0;
 };
 
@@ -66,23 +68,42 @@ struct GeodesicProvider {
   std::function<bool(const Eigen::Vector2d& a, const Eigen::Vector2d& b,
                      std::vector<Eigen::Vector2d>* out)>
       shortest_path;
+  // Raster cells some robot reaches by these geodesics (one byte per cell, non-zero =
+  // reachable), and how many robots reach any cell: where views may stand. Null: the planner's
+  // own flood fill (AccessibleCells).
+  const std::vector<std::uint8_t>* accessible_cells = nullptr;
+  int anchored_robots = 0;
 };
 
-// The accessible task views of one pass (§3.2, at most κR) and the internal geodesic grid they
-// were checked on: PlanOmt's first stage, exposed so the baselines (GRD, SEG of §4) plan over
-// exactly the same views. kappa, robot_radius_m, views and use_task_views apply as in PlanOmt.
+// Raster cells a robot of radius robot_radius_m can drive to: free cells with clearance >=
+// robot_radius_m, 8-connected without cutting corners, flooded from each robot's cell (or, when
+// it is not such a cell, the nearest one within snap_radius_m, as the host snaps robots standing
+// on cells their camera never saw). *anchored counts the robots that seeded the flood. This is
+// the host's own traversability rule at the raster's full resolution: a coarser grid would shut
+// doorways barely wider than the robot.
+std::vector<std::uint8_t> AccessibleCells(const OccupancyRaster& raster,
+                                          const ClearanceRaster& clearance,
+                                          const std::vector<RobotState>& robots,
+                                          double robot_radius_m, double snap_radius_m = 0.5,
+                                          int* anchored = nullptr);
+
+// The accessible task views of one pass (§3.2, at most κR): PlanOmt's first stage, exposed so
+// the baselines (GRD, SEG of §4) plan over exactly the same views. kappa, robot_radius_m, views
+// and use_task_views apply as in PlanOmt. Views stand on accessible cells: accessible_cells when
+// given (e.g. the host's geodesic fields), else AccessibleCells.
 struct ViewSet {
-  GeodesicGrid grid;
-  std::vector<Anchor> anchors;          // one per robot, then one per view
-  std::vector<std::uint8_t> reachable;  // grid nodes some robot reaches
-  std::vector<TaskView> views;          // only views whose anchor is reachable
+  std::vector<std::uint8_t> accessible;  // raster cells some robot reaches
+  int anchored_robots = 0;               // robots that reach any cell
+  std::vector<TaskView> views;
 };
 ViewSet ExtractAccessibleViews(const OccupancyRaster& raster, const ClearanceRaster& clearance,
-                               const std::vector<RobotState>& robots,
-                               const PlannerOptions& options);
+                               const std::vector<RobotState>& robots, const PlannerOptions& options,
+                               const std::vector<std::uint8_t>* accessible_cells = nullptr,
+                               int anchored_robots = 0);
 
 // clearance may be null: it is then computed from the raster (unknown counts as obstacle).
-// Views are still restricted to cells the internal grid reaches from some robot.
+// Without a provider's distances, geodesics run on the internal grid (geodesic_cell_m); a view
+// the grid cannot join (a narrow passage between two coarse nodes) is then unreachable.
 Status PlanOmt(const OccupancyRaster& raster, const ClearanceRaster* clearance,
                const std::vector<RobotState>& robots, const PlannerOptions& options,
                PlanResult* result, const GeodesicProvider* provider = nullptr);

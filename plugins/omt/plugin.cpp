@@ -39,9 +39,18 @@ class OmtPlanner : public vp::Planner {
       in = ReadWorld(world, options_);
     }
     if (in.robots.empty()) return;  // nobody to plan for; not "done" either
+    settled_.Apply(world, PassOptions(options_, in), &in);
+    out.Diagnostic("settled_cells", double(settled_.size()));
+    out.Diagnostic("surface_voxels_ms", in.surface_voxels_ms);
 
     double host_ms = 0.0;
-    const omt::GeodesicProvider provider = HostGeodesics(world, in.min_clearance_m, &host_ms);
+    omt::GeodesicProvider provider = HostGeodesics(world, in.min_clearance_m, &host_ms);
+    if (options_.geodesics == "host") {
+      vp::StageTimer timer(world, out, "reach");
+      ReadHostReach(world, &in);
+      provider.accessible_cells = &in.accessible;
+      provider.anchored_robots = in.anchored_robots;
+    }
     omt::PlanResult result;
     const double start_s = world.ElapsedS();
     const omt::Status status =
@@ -58,7 +67,7 @@ class OmtPlanner : public vp::Planner {
         out.SetDone(true);
       } else {
         world.Log(VP_LOG_WARNING,
-                  "omt: no robot stands on the geodesic grid (too little known free space "
+                  "omt: no robot can reach any cell (too little known free space "
                   "around it?); not done, no tasks");
       }
       return;
@@ -142,6 +151,7 @@ class OmtPlanner : public vp::Planner {
   }
 
   CommonOptions options_;
+  SettledCells settled_;  // cells looked at in vain, across calls
 };
 
 }  // namespace

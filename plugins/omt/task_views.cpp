@@ -33,7 +33,7 @@ std::vector<Candidate> CollectCandidates(const OccupancyRaster& raster,
                                 (x + 1 < g.width && raster.At(i + 1) == Cell::kFree) ||
                                 (y > 0 && raster.At(i - g.width) == Cell::kFree) ||
                                 (y + 1 < g.height && raster.At(i + g.width) == Cell::kFree);
-      if (!next_to_free) continue;
+      if (!next_to_free || raster.SettledAt(i)) continue;
       const double u = CellUncertainty(c, raster.WeightAt(i), params);
       if (c == Cell::kOccupied && u < params.min_surface_uncertainty) continue;
       out.push_back({i, static_cast<float>(u)});
@@ -91,13 +91,15 @@ double ViewImportance(const OccupancyRaster& raster, const Eigen::Vector2d& p_m,
         const double gain =
             (unknown_since >= 0.0 ? std::exp(-(t - unknown_since) / u.unknown_decay_m) : 1.0) *
             (1.0 / (1.0 + w) - 1.0 / (1.0 + w + q * u.observation_weight));
-        contribute(cell, gain);
+        contribute(cell, raster.SettledAt(cell) ? 0.0 : gain);
         return false;
       }
       if (unknown_since < 0.0) unknown_since = t;
       const double visibility = std::exp(-(t - unknown_since) / u.unknown_decay_m);
       if (visibility < kMinVisibility) return false;
-      contribute(cell, u.unknown_uncertainty * DistanceProfile(d, s) * visibility);
+      contribute(cell, raster.SettledAt(cell)
+                           ? 0.0
+                           : u.unknown_uncertainty * DistanceProfile(d, s) * visibility);
       return true;
     });
   }

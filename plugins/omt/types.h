@@ -45,10 +45,17 @@ struct OccupancyRaster {
   std::vector<Cell> cells;
   // TSDF weight per cell (§3.2 uncertainty of surface cells); empty means weight 0 everywhere.
   std::vector<float> tsdf_weight;
+  // Cells a robot looked at from a task view without the map resolving them (non-zero): their
+  // uncertainty is out of the sensor's reach from there, so they are neither queued nor counted
+  // in a view's importance (they still hide what lies behind). Empty: none.
+  std::vector<std::uint8_t> settled;
 
   Cell At(int index) const { return cells[static_cast<std::size_t>(index)]; }
   float WeightAt(int index) const {
     return tsdf_weight.empty() ? 0.0f : tsdf_weight[static_cast<std::size_t>(index)];
+  }
+  bool SettledAt(int index) const {
+    return !settled.empty() && settled[static_cast<std::size_t>(index)] != 0;
   }
 };
 

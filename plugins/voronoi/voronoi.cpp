@@ -27,11 +27,12 @@ class VoronoiPlanner : public vp::Planner {
     BaselineWorld b;
     {
       vp::StageTimer timer(world, out, "views");
-      b = ReadBaselineWorld(world, options_);
+      b = ReadBaselineWorld(world, options_, &settled_);
     }
     out.DebugPoints("voronoi_views", ViewPointsXyz(b.views, b.input.map.floor_z_m), 0xffa000ffu);
     if (!b.any_important_reachable) {
       ReportViews(out, b, 0);
+      out.Diagnostic("settled_cells", double(settled_.size()));
       out.SetDone(b.Done());
       return;
     }
@@ -76,10 +77,12 @@ class VoronoiPlanner : public vp::Planner {
       tasks += int(chosen.size());
     }
     ReportViews(out, b, tasks);
+    out.Diagnostic("settled_cells", double(settled_.size()));
   }
 
  private:
   CommonOptions options_;
+  SettledCells settled_;  // cells looked at in vain, across calls
   int tasks_per_call_ = 1;
   double failed_radius_m_ = 0.5;  // views this close to a failed task are not retried at once
 };

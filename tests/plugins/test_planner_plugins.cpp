@@ -236,8 +236,8 @@ TEST(Planners, DoneOnAFullyExploredWorld) {
 }
 
 TEST(Planners, NotDoneWhileNoRobotStandsOnKnownFreeSpace) {
-  // A robot in a 0.3 m patch of known floor amid unknown space: nothing can be judged yet, which
-  // must not read as "explored".
+  // A robot in a 0.3 m patch of known floor amid unknown space: the scene cannot be judged yet,
+  // which must not read as "explored"; a view, if any, stands on the patch (turning to look).
   test::RasterWorld world(60, 60, 0.05f);
   world.Fill(0, 0, 59, 59, FloorCell::kUnknown);
   world.Fill(27, 27, 32, 32, FloorCell::kFree);
@@ -248,7 +248,30 @@ TEST(Planners, NotDoneWhileNoRobotStandsOnKnownFreeSpace) {
     ASSERT_TRUE(planner);
     const PlanResult r = MustPlan(*planner, world);
     EXPECT_FALSE(r.done) << name;
-    EXPECT_TRUE(r.robots[0].tasks.empty()) << name;
+    for (const PlannerTask& t : r.robots[0].tasks) {
+      EXPECT_EQ(world.CellAt(t.position_m), FloorCell::kFree) << name;
+    }
+  }
+}
+
+TEST(Planners, DoneOnceAnIdleRobotLookedAtWhatStaysUnknown) {
+  // A scanned room with an unknown pocket 2 m ahead of an idle robot: facing it, the robot has
+  // looked at it from within range and it stayed unknown (the sensor cannot resolve it from
+  // there), so nothing is worth a view; facing away, the pocket still is.
+  for (const float theta : {0.f, 3.1416f}) {
+    test::RasterWorld world(80, 40, 0.05f);
+    world.Walls();
+    world.Fill(50, 15, 55, 25, FloorCell::kUnknown);
+    world.Finish();
+    world.set_surface_weight(1000.f);
+    world.AddRobot(10, 20, 0.18f).theta_rad = theta;
+    for (const std::string& name : kPlanners) {
+      auto planner = MustLoad(name);
+      ASSERT_TRUE(planner);
+      const PlanResult r = MustPlan(*planner, world);
+      EXPECT_EQ(r.done, theta == 0.f) << name << " facing " << theta;
+      EXPECT_EQ(r.robots[0].tasks.empty(), theta == 0.f) << name << " facing " << theta;
+    }
   }
 }
 

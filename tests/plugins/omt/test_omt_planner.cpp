@@ -63,6 +63,43 @@ TEST_F(OmtPlanner, FullPassAssignsEachViewOnceAlongCollisionFreePaths) {
     }
 }
 
+TEST(OmtAccessibility, ADoorwayBarelyWiderThanTheRobotLeadsOn) {
+  // Two rooms joined by a 0.5 m doorway (0.25 m clearance in its middle, a 0.18 m robot passes);
+  // the right room is half unknown. Views there must count as accessible: the coarse geodesic
+  // grid alone (nodes 0.2 m apart needing 0.36 m of clearance) would shut the door.
+  constexpr double kDoorM = 0.5;
+  OccupancyRaster r = testing::MakeRaster(8.0, 4.0, 0.05, Cell::kFree);
+  testing::FrameRect(&r, 0.0, 0.0, 8.0, 4.0);
+  testing::FillRect(&r, 4.0, 0.0, 4.1, 2.0 - 0.5 * kDoorM, Cell::kOccupied);
+  testing::FillRect(&r, 4.0, 2.0 + 0.5 * kDoorM, 4.1, 4.0, Cell::kOccupied);
+  testing::FillRect(&r, 6.0, 0.1, 7.9, 3.9, Cell::kUnknown);
+  const ClearanceRaster clearance = ComputeClearance(r);
+  std::vector<RobotState> robots(1);
+  robots[0].position_m = {1.0, 2.0};
+  PlannerOptions options;
+  int anchored = 0;
+  const std::vector<std::uint8_t> cells =
+      AccessibleCells(r, clearance, robots, options.robot_radius_m, 0.5, &anchored);
+  EXPECT_EQ(anchored, 1);
+  EXPECT_TRUE(cells[static_cast<std::size_t>(r.geometry.IndexOf({5.0, 2.0}))]);
+  for (std::size_t i = 0; i < cells.size(); ++i) {
+    if (cells[i]) {
+      EXPECT_GE(clearance.clearance_m[i], options.robot_radius_m);
+    }
+  }
+  const ViewSet set = ExtractAccessibleViews(r, clearance, robots, options);
+  EXPECT_EQ(set.anchored_robots, 1);
+  int behind_door = 0;
+  for (const TaskView& v : set.views) behind_door += v.position_m.x() > 4.1;
+  EXPECT_GT(behind_door, 0);
+  // A robot off the free cells (inside the wall) is snapped within the radius, or not at all.
+  robots[0].position_m = {4.05, 1.0};
+  AccessibleCells(r, clearance, robots, options.robot_radius_m, 0.5, &anchored);
+  EXPECT_EQ(anchored, 1);
+  AccessibleCells(r, clearance, robots, options.robot_radius_m, 0.1, &anchored);
+  EXPECT_EQ(anchored, 0);
+}
+
 TEST_F(OmtPlanner, DeterministicAndIndependentOfThreadCount) {
   PlannerOptions options;
   PlanResult a, b;

@@ -132,6 +132,21 @@ TEST(OmtTaskViews, TerminatesOnlyWhenNoImportantViewRemains) {
   EXPECT_TRUE(ShouldTerminate(views));
 }
 
+TEST(OmtTaskViews, SettledCellsAreNeitherQueuedNorCounted) {
+  // The unknown half settled (looked at in vain): no frontier candidate, no view worth it; the
+  // walls (weight 3) are not worth one either.
+  OccupancyRaster r = PartialRoom(3.0f);
+  const ClearanceRaster clearance = ComputeClearance(r);
+  EXPECT_FALSE(ShouldTerminate(ExtractTaskViews(r, clearance, Params())));
+  r.settled.assign(r.cells.size(), 0);
+  for (std::size_t i = 0; i < r.cells.size(); ++i) r.settled[i] = r.cells[i] == Cell::kUnknown;
+  for (const Candidate& c : CollectCandidates(r, UncertaintyParams{}))
+    EXPECT_NE(r.At(c.cell), Cell::kUnknown);
+  const Eigen::Vector2d p(3.0, 2.0);
+  EXPECT_EQ(ViewImportance(r, p, 0.0, Params()), 0.0);  // facing the settled half
+  EXPECT_TRUE(ShouldTerminate(ExtractTaskViews(r, clearance, Params())));
+}
+
 TEST(OmtTaskViews, AccessibilityMaskRestrictsViewCells) {
   const OccupancyRaster r = PartialRoom(1.0f);
   const ClearanceRaster clearance = ComputeClearance(r);
