@@ -1,7 +1,15 @@
-// GRD, the greedy baseline of Dong et al. 2019 §4, as a plugin: over the OMT pass's task views,
-// each robot this call plans (robot index order) takes the nearest (geodesic) view with
-// importance above the threshold that no other robot holds; one task per robot per call, and it
-// plans again when the robot turns idle. Done when no robot can reach such a view.
+// GRD, the greedy baseline of Dong et al. 2019 §4, as a plugin, over the OMT pass's task views
+// with importance above the threshold. Two policies ("policy"):
+//  - "best" (default, the paper's GRD): the views are assigned greedily, best first, each to the
+//    robot with the fewest views so far (nearest among those), so the whole team is dispatched
+//    to the best views at once; each planned robot then takes the closest of its own views.
+//  - "nearest": each robot this call plans (robot index order) takes the nearest (geodesic) view
+//    that no other robot holds, a nearest-frontier baseline.
+// One task per robot per call either way; it plans again when the robot turns idle. Done when no
+// robot can reach such a view.
+#include <algorithm>
+#include <cmath>
+#include <numeric>
 #include <string>
 #include <vector>
 
@@ -17,6 +25,7 @@ class GreedyPlanner : public vp::Planner {
     JsonOptions json("greedy", config.json);
     options_ = ReadCommonOptions(json);
     claim_radius_m_ = json.Number("claim_radius_m", claim_radius_m_, 0.0, 100.0);
+    best_ = json.Choice("policy", "best", {"best", "nearest"}) == "best";
     json.RejectUnknownKeys();
   }
 
@@ -45,6 +54,15 @@ class GreedyPlanner : public vp::Planner {
         }
       }
     }
+    const int tasks = best_ ? PlanBest(world, out, b, planned, claimed)
+                            : PlanNearest(world, out, b, planned, claimed);
+    ReportViews(out, b, tasks);
+    out.Diagnostic("settled_cells", double(settled_.size()));
+  }
+
+ private:
+  int PlanNearest(const vp::WorldView& world, vp::PlanOutput& out, const BaselineWorld& b,
+                  const std::vector<uint8_t>& planned, std::vector<uint8_t> claimed) {
     int tasks = 0;
     for (uint32_t r = 0; r < planned.size(); ++r) {
       if (!planned[r]) continue;
@@ -59,14 +77,63 @@ class GreedyPlanner : public vp::Planner {
       EmitViews(world, out, b, r, {k}, options_.dwell_s, "greedy_paths");
       ++tasks;
     }
-    ReportViews(out, b, tasks);
-    out.Diagnostic("settled_cells", double(settled_.size()));
+    return tasks;
   }
 
- private:
+  // The assignment runs over every robot, not only the planned ones, so that a robot's share of
+  // the best views does not depend on which event triggered the call. A robot keeping its queue
+  // (not planned) starts with its queued tasks counted, so an idle robot is served first instead
+  // of losing the best remaining view to a busy one; the views in those queues are out of the
+  // pool (claimed), and what a busy robot is assigned here is dropped (it keeps its queue).
+  int PlanBest(const vp::WorldView& world, vp::PlanOutput& out, const BaselineWorld& b,
+               const std::vector<uint8_t>& planned, const std::vector<uint8_t>& claimed) {
+    const size_t robots = planned.size();
+    std::vector<std::vector<uint8_t>> allowed(robots);  // per robot: important, not just failed
+    std::vector<size_t> count(robots, 0);
+    for (uint32_t r = 0; r < robots; ++r) {
+      allowed[r] = AllowedViews(world, b, r, claim_radius_m_);
+      if (!planned[r]) count[r] = world.Queue(r).size();
+    }
+    // Best first; stable, so equal importance keeps the lower index first.
+    std::vector<size_t> order(b.views.size());
+    std::iota(order.begin(), order.end(), size_t(0));
+    std::stable_sort(order.begin(), order.end(), [&](size_t x, size_t y) {
+      return b.views[x].importance > b.views[y].importance;
+    });
+    std::vector<std::vector<uint8_t>> assigned(robots, std::vector<uint8_t>(b.views.size(), 0));
+    for (const size_t v : order) {
+      if (claimed[v]) continue;
+      int to = -1;
+      for (uint32_t r = 0; r < robots; ++r) {
+        if (!allowed[r][v] || !std::isfinite(b.robot_view_m[r][v])) continue;
+        const size_t t = size_t(to);
+        if (to < 0 || count[r] < count[t] ||
+            (count[r] == count[t] && b.robot_view_m[r][v] < b.robot_view_m[t][v])) {
+          to = int(r);
+        }
+      }
+      if (to < 0) continue;  // nobody may take it
+      assigned[size_t(to)][v] = 1;
+      ++count[size_t(to)];
+    }
+    int tasks = 0;
+    for (uint32_t r = 0; r < robots; ++r) {
+      if (!planned[r]) continue;
+      const int k = NearestView(b.robot_view_m[r], assigned[r]);
+      if (k < 0) {
+        out.ReplaceTasks(r);  // no view of its own: stop rather than finish a stale task
+        continue;
+      }
+      EmitViews(world, out, b, r, {k}, options_.dwell_s, "greedy_paths");
+      ++tasks;
+    }
+    return tasks;
+  }
+
   CommonOptions options_;
   SettledCells settled_;         // cells looked at in vain, across calls
   double claim_radius_m_ = 0.5;  // a view this close to another robot's queued task is its
+  bool best_ = true;             // "policy": "best" (the paper's GRD) or "nearest"
 };
 
 }  // namespace

@@ -1,7 +1,7 @@
 // The real planner plugins (omt, greedy, voronoi) through the host: loading by name, valid tasks
 // on grid worlds (the host's validation rejects none), determinism, termination on an explored
 // world, and each baseline's defining rule (GRD: distinct views; SEG: each view to its nearest
-// robot).
+// robot; GRD "best": the best views go to the whole team).
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -278,54 +278,123 @@ TEST(Planners, DoneOnceAnIdleRobotLookedAtWhatStaysUnknown) {
 TEST(Planners, GreedyGivesDistinctRobotsDistinctViews) {
   // Four robots, two per room: the pairs start at the same nearest view and must split.
   const test::RasterWorld world = test::ApartmentWorld(8.f, 6.f, 0.05f, 4, 5.5f, 4.f);
-  auto planner = MustLoad("greedy");
-  ASSERT_TRUE(planner);
-  const PlanResult r = MustPlan(*planner, world);
-  std::set<uint32_t> tags;
-  std::set<std::pair<float, float>> positions;
-  for (const RobotPlan& plan : r.robots) {
-    ASSERT_EQ(plan.tasks.size(), 1u);  // one task per robot per call
-    EXPECT_TRUE(tags.insert(plan.tasks[0].tag).second);
-    EXPECT_TRUE(
-        positions.insert({plan.tasks[0].position_m.x(), plan.tasks[0].position_m.y()}).second);
+  for (const char* config : {R"({"policy": "best"})", R"({"policy": "nearest"})"}) {
+    auto planner = MustLoad("greedy", config);
+    ASSERT_TRUE(planner);
+    const PlanResult r = MustPlan(*planner, world);
+    std::set<uint32_t> tags;
+    std::set<std::pair<float, float>> positions;
+    for (const RobotPlan& plan : r.robots) {
+      ASSERT_EQ(plan.tasks.size(), 1u) << config;  // one task per robot per call
+      EXPECT_TRUE(tags.insert(plan.tasks[0].tag).second) << config;
+      EXPECT_TRUE(
+          positions.insert({plan.tasks[0].position_m.x(), plan.tasks[0].position_m.y()}).second)
+          << config;
+    }
   }
 }
 
+// A 6 x 2 m scanned room: a small unknown pocket P at the bottom left, right behind robot 0 (it
+// faces away, so it has not looked at it), and a large unknown block U at the right end; robot 1
+// waits in the top left corner, farther from U than robot 0. With kappa 1 the pass extracts two
+// views, P first (its cells have the lowest indices) and then one of U, the more important.
+test::RasterWorld PocketAndBlockWorld() {
+  test::RasterWorld world(120, 40, 0.05f);
+  world.Walls();
+  world.Fill(4, 1, 11, 6, FloorCell::kUnknown);      // P
+  world.Fill(100, 2, 118, 38, FloorCell::kUnknown);  // U
+  world.Finish();
+  world.set_surface_weight(1000.f);  // only unknown space is worth a view
+  world.AddRobot(20, 12, 0.18f).theta_rad = 0.f;
+  world.AddRobot(8, 30, 0.18f).theta_rad = 1.5708f;
+  return world;
+}
+
+TEST(Planners, GreedyBestSendsTheTeamToTheBestViewsNotTheNearest) {
+  const test::RasterWorld world = PocketAndBlockWorld();
+  const int width = world.Floor().width;
+  auto in_pocket = [&](const PlannerTask& t) { return int(t.tag % uint32_t(width)) <= 12; };
+  auto in_block = [&](const PlannerTask& t) { return int(t.tag % uint32_t(width)) >= 99; };
+  std::map<std::string, PlanResult> results;
+  for (const char* policy : {"best", "nearest"}) {
+    auto planner = MustLoad("greedy", std::string(R"({"kappa": 1, "policy": ")") + policy + "\"}");
+    ASSERT_TRUE(planner);
+    results[policy] = MustPlan(*planner, world);
+    const PlanResult& r = results[policy];
+    ASSERT_EQ(Diagnostics(r).at("views_important"), 2.0) << policy;
+    for (const RobotPlan& plan : r.robots) ASSERT_EQ(plan.tasks.size(), 1u) << policy;
+  }
+  // best: U, the better view, goes to the nearer of the two robots (both hold none yet), robot
+  // 0; P to the robot with fewer views, robot 1, although robot 0 stands next to it.
+  EXPECT_TRUE(in_block(results["best"].robots[0].tasks[0]));
+  EXPECT_TRUE(in_pocket(results["best"].robots[1].tasks[0]));
+  // nearest: robot 0 plans first and takes P, robot 1 what is left.
+  EXPECT_TRUE(in_pocket(results["nearest"].robots[0].tasks[0]));
+  EXPECT_TRUE(in_block(results["nearest"].robots[1].tasks[0]));
+  // Without the default, best is what runs.
+  auto plain = MustLoad("greedy", R"({"kappa": 1})");
+  ASSERT_TRUE(plain);
+  EXPECT_EQ(Bytes(MustPlan(*plain, world)), Bytes(results["best"]));
+}
+
+TEST(Planners, GreedyPoliciesAreDeterministicAndCheckedAtLoad) {
+  const test::RasterWorld world = SmallApartment();
+  for (const char* config : {R"({"policy": "best"})", R"({"policy": "nearest"})"}) {
+    auto a = MustLoad("greedy", config, 3);
+    auto b = MustLoad("greedy", config, 3);
+    ASSERT_TRUE(a && b);
+    const std::vector<uint8_t> first = Bytes(MustPlan(*a, world));
+    EXPECT_GT(first.size(), 1u);
+    EXPECT_EQ(first, Bytes(MustPlan(*b, world))) << config;
+  }
+  PlannerLoadOptions o;
+  o.config_json = R"({"policy": "closest"})";
+  auto bad = LoadPlanner("greedy", o);
+  ASSERT_FALSE(bad.ok());
+  EXPECT_NE(bad.status().message().find("policy"), std::string::npos) << bad.status().message();
+}
+
 TEST(Planners, GreedyOnIdlePlansOnlyTheIdleRobotAroundOthersQueues) {
-  test::RasterWorld world = test::ApartmentWorld(8.f, 6.f, 0.05f, 2, 5.5f, 4.f);
-  auto planner = MustLoad("greedy");
-  ASSERT_TRUE(planner);
-  // Robot 1 is busy with the view greedy would give it; robot 0 turns idle next to it.
-  const PlanResult start = MustPlan(*planner, world);
-  ASSERT_EQ(start.robots[1].tasks.size(), 1u);
-  world.robots()[1].executing = true;
-  world.robots()[1].queue = start.robots[1].tasks;
-  PlanRequest idle;
-  idle.event = PlanEvent::kRobotIdle;
-  idle.event_robot = 0;
-  const PlanResult r = MustPlan(*planner, world, idle);
-  EXPECT_TRUE(r.robots[1].tasks.empty());
-  EXPECT_EQ(r.robots[1].policy, TaskPolicy::kAppend);  // its queue is left alone
-  ASSERT_EQ(r.robots[0].tasks.size(), 1u);
-  EXPECT_NE(r.robots[0].tasks[0].tag, start.robots[1].tasks[0].tag);
+  for (const char* config : {R"({"policy": "best"})", R"({"policy": "nearest"})"}) {
+    test::RasterWorld world = test::ApartmentWorld(8.f, 6.f, 0.05f, 2, 5.5f, 4.f);
+    auto planner = MustLoad("greedy", config);
+    ASSERT_TRUE(planner);
+    // Robot 1 is busy with the view greedy would give it; robot 0 turns idle next to it.
+    const PlanResult start = MustPlan(*planner, world);
+    ASSERT_EQ(start.robots[1].tasks.size(), 1u) << config;
+    world.robots()[1].executing = true;
+    world.robots()[1].queue = start.robots[1].tasks;
+    PlanRequest idle;
+    idle.event = PlanEvent::kRobotIdle;
+    idle.event_robot = 0;
+    const PlanResult r = MustPlan(*planner, world, idle);
+    EXPECT_TRUE(r.robots[1].tasks.empty()) << config;
+    EXPECT_EQ(r.robots[1].policy, TaskPolicy::kAppend) << config;  // its queue is left alone
+    ASSERT_EQ(r.robots[0].tasks.size(), 1u) << config;
+    EXPECT_NE(r.robots[0].tasks[0].tag, start.robots[1].tasks[0].tag) << config;
+  }
 }
 
 TEST(Planners, BaselinesDoNotRetryAFailedViewAtOnce) {
-  for (const char* name : {"greedy", "voronoi"}) {
+  const std::vector<std::pair<std::string, std::string>> planners = {
+      {"greedy", R"({"policy": "best"})"},
+      {"greedy", R"({"policy": "nearest"})"},
+      {"voronoi", "{}"}};
+  for (const auto& [name, config] : planners) {
     test::RasterWorld world = SmallApartment();
-    auto planner = MustLoad(name);
+    auto planner = MustLoad(name, config);
     ASSERT_TRUE(planner);
     const PlanResult start = MustPlan(*planner, world);
-    ASSERT_EQ(start.robots[1].tasks.size(), 1u) << name;
+    ASSERT_EQ(start.robots[1].tasks.size(), 1u) << name << config;
     PlanRequest failed;
     failed.event = PlanEvent::kTaskFailed;
     failed.event_robot = 1;
     failed.failed_task = start.robots[1].tasks[0];
     const PlanResult r = MustPlan(*planner, world, failed);
-    EXPECT_EQ(r.robots[1].tasks.size(), 1u) << name;  // another view of its own
+    EXPECT_EQ(r.robots[1].tasks.size(), 1u) << name << config;  // another view of its own
     for (const PlannerTask& t : r.robots[1].tasks) {
-      EXPECT_NE(t.tag, failed.failed_task.tag) << name;
-      EXPECT_GT((t.position_m - failed.failed_task.position_m).norm(), 0.5f) << name;
+      EXPECT_NE(t.tag, failed.failed_task.tag) << name << config;
+      EXPECT_GT((t.position_m - failed.failed_task.position_m).norm(), 0.5f) << name << config;
     }
   }
 }
