@@ -117,12 +117,27 @@ void EmitViews(const vp::WorldView& world, vp::PlanOutput& out, const BaselineWo
   out.DebugPolyline(layer, xyz, 0x40ff40ffu);
 }
 
-void ReportViews(vp::PlanOutput& out, const BaselineWorld& b, int tasks) {
+void ReportViews(vp::PlanOutput& out, const BaselineWorld& b, int tasks,
+                 const SettledCells& settled) {
   int important = 0;
   for (uint8_t i : b.important) important += i;
   out.Diagnostic("views", double(b.views.size()));
   out.Diagnostic("views_important", important);
   out.Diagnostic("tasks", tasks);
+  out.Diagnostic("settled_cells", double(settled.size()));
+}
+
+bool BeginPass(const vp::WorldView& world, vp::PlanOutput& out, const CommonOptions& options,
+               SettledCells* settled, const std::string& layer, BaselineWorld* b) {
+  {
+    vp::StageTimer timer(world, out, "views");
+    *b = ReadBaselineWorld(world, options, settled);
+  }
+  out.DebugPoints(layer, ViewPointsXyz(b->views, b->input.map.floor_z_m), 0xffa000ffu);
+  if (b->any_important_reachable) return true;
+  ReportViews(out, *b, 0, *settled);
+  out.SetDone(b->Done());
+  return false;
 }
 
 }  // namespace voxplan::planners

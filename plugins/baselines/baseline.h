@@ -51,7 +51,14 @@ int NearestView(const std::vector<float>& dist, const std::vector<uint8_t>& allo
 void EmitViews(const vp::WorldView& world, vp::PlanOutput& out, const BaselineWorld& b, uint32_t r,
                const std::vector<int>& view_ids, double dwell_s, const std::string& layer);
 
-// Diagnostics both baselines report: views, views_important, tasks.
-void ReportViews(vp::PlanOutput& out, const BaselineWorld& b, int tasks);
+// Diagnostics both baselines report: views, views_important, tasks, settled_cells.
+void ReportViews(vp::PlanOutput& out, const BaselineWorld& b, int tasks,
+                 const SettledCells& settled);
+
+// The start of a baseline pass: reads the world (timed as stage "views"), draws its views in
+// `layer`; when no robot can reach an important view, reports that (done when nothing is left)
+// and returns false: the pass ends there.
+bool BeginPass(const vp::WorldView& world, vp::PlanOutput& out, const CommonOptions& options,
+               SettledCells* settled, const std::string& layer, BaselineWorld* b);
 
 }  // namespace voxplan::planners

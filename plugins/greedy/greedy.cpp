@@ -32,17 +32,7 @@ class GreedyPlanner : public vp::Planner {
   void Plan(const vp::WorldView& world, vp::PlanOutput& out) override {
     vp::StageTimer total(world, out, "plan");
     BaselineWorld b;
-    {
-      vp::StageTimer timer(world, out, "views");
-      b = ReadBaselineWorld(world, options_, &settled_);
-    }
-    out.DebugPoints("greedy_views", ViewPointsXyz(b.views, b.input.map.floor_z_m), 0xffa000ffu);
-    if (!b.any_important_reachable) {
-      ReportViews(out, b, 0);
-      out.Diagnostic("settled_cells", double(settled_.size()));
-      out.SetDone(b.Done());
-      return;
-    }
+    if (!BeginPass(world, out, options_, &settled_, "greedy_views", &b)) return;
     const std::vector<uint8_t> planned = RobotsToPlan(world, b);
     // Views another robot still holds in its queue are taken.
     std::vector<uint8_t> claimed(b.views.size(), 0);
@@ -56,8 +46,7 @@ class GreedyPlanner : public vp::Planner {
     }
     const int tasks = best_ ? PlanBest(world, out, b, planned, claimed)
                             : PlanNearest(world, out, b, planned, claimed);
-    ReportViews(out, b, tasks);
-    out.Diagnostic("settled_cells", double(settled_.size()));
+    ReportViews(out, b, tasks, settled_);
   }
 
  private:

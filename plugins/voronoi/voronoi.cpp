@@ -25,17 +25,7 @@ class VoronoiPlanner : public vp::Planner {
   void Plan(const vp::WorldView& world, vp::PlanOutput& out) override {
     vp::StageTimer total(world, out, "plan");
     BaselineWorld b;
-    {
-      vp::StageTimer timer(world, out, "views");
-      b = ReadBaselineWorld(world, options_, &settled_);
-    }
-    out.DebugPoints("voronoi_views", ViewPointsXyz(b.views, b.input.map.floor_z_m), 0xffa000ffu);
-    if (!b.any_important_reachable) {
-      ReportViews(out, b, 0);
-      out.Diagnostic("settled_cells", double(settled_.size()));
-      out.SetDone(b.Done());
-      return;
-    }
+    if (!BeginPass(world, out, options_, &settled_, "voronoi_views", &b)) return;
     // The partition: every robot's region, also of robots this call leaves alone.
     const size_t robots = b.input.robots.size();
     std::vector<int> owner(b.views.size(), -1);
@@ -76,8 +66,7 @@ class VoronoiPlanner : public vp::Planner {
       EmitViews(world, out, b, r, chosen, options_.dwell_s, "voronoi_paths");
       tasks += int(chosen.size());
     }
-    ReportViews(out, b, tasks);
-    out.Diagnostic("settled_cells", double(settled_.size()));
+    ReportViews(out, b, tasks, settled_);
   }
 
  private:
