@@ -224,16 +224,27 @@ void SettledCells::Update(const vp::WorldView& world, const WorldInput& input,
   const omt::OccupancyRaster& raster = input.raster;
   const omt::RasterGeometry& g = raster.geometry;
   if (g.NumCells() == 0) return;
-  auto key = [&](int cell) {
-    const Eigen::Vector2d c = g.Center(cell) / g.resolution_m;
-    return std::make_pair(long(std::floor(c.x())), long(std::floor(c.y())));
-  };
+  auto key = [&](int cell) { return KeyOf(g, cell); };
   // Rays half a cell apart at the far range reach every cell of the fan.
   const double step = 0.5 * g.resolution_m / sensor.d_max_m;
   const int rays = std::max(1, int(std::ceil(sensor.fov_rad / step)));
   for (size_t r = 0; r < input.robots.size(); ++r) {
     if (input.robots[r].status != VP_ROBOT_IDLE) continue;
-    if (world.event() == VP_EVENT_TASK_FAILED && world.call().event_robot == int32_t(r)) continue;
+    const auto given = given_.find(uint32_t(r));
+    if (world.event() == VP_EVENT_TASK_FAILED && world.call().event_robot == int32_t(r)) {
+      if (given != given_.end()) given_.erase(given);
+      continue;
+    }
+    bool repeated = false;  // r just took a view of a target it had taken before
+    if (given != given_.end()) {
+      for (const Key& k : given->second) {
+        if (++taken_[k] >= kRepeatLimit) {
+          repeated = true;
+          cells_.insert(k);
+        }
+      }
+      given_.erase(given);
+    }
     const Eigen::Vector2d p = input.states[r].position_m;
     const int start = g.IndexOf(p);
     for (int k = 0; k <= rays; ++k) {
@@ -248,7 +259,8 @@ void SettledCells::Update(const vp::WorldView& world, const WorldInput& input,
         if (c == omt::Cell::kOccupied) {
           const double u = omt::CellUncertainty(c, raster.WeightAt(cell), uncertainty);
           // A surface gains weight with every look; only one that stays unscanned is settled.
-          if (in_range && u >= uncertainty.unknown_uncertainty) cells_.insert(key(cell));
+          if (in_range && (repeated || u >= uncertainty.unknown_uncertainty))
+            cells_.insert(key(cell));
           return false;
         }
         if (in_range) cells_.insert(key(cell));
@@ -256,6 +268,22 @@ void SettledCells::Update(const vp::WorldView& world, const WorldInput& input,
       });
     }
   }
+}
+
+SettledCells::Key SettledCells::KeyOf(const omt::RasterGeometry& g, int cell) const {
+  const Eigen::Vector2d c = g.Center(cell) / g.resolution_m;
+  return {long(std::floor(c.x())), long(std::floor(c.y()))};
+}
+
+void SettledCells::Remember(uint32_t r, const omt::RasterGeometry& g,
+                            const std::vector<omt::TaskView>& views, const std::vector<int>& ids) {
+  std::vector<Key>& keys = given_[r];
+  keys.clear();
+  for (int id : ids) {
+    const int cell = views[size_t(id)].target_cell;
+    if (cell >= 0 && cell < g.NumCells()) keys.push_back(KeyOf(g, cell));
+  }
+  if (keys.empty()) given_.erase(r);
 }
 
 void SettledCells::Apply(const vp::WorldView& world, const omt::PlannerOptions& options,

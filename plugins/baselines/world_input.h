@@ -5,6 +5,7 @@
 
 #include <Eigen/Core>
 #include <cstdint>
+#include <map>
 #include <nlohmann/json.hpp>
 #include <set>
 #include <string>
@@ -101,8 +102,20 @@ class SettledCells {
   std::vector<uint8_t> Mask(const omt::RasterGeometry& g) const;
   size_t size() const { return cells_.size(); }
 
+  // The target cells of the views robot r was just given (ids into views, over raster g). When
+  // r is next idle it has taken them: a target taken kRepeatLimit times whose view still comes
+  // back is settled, with every cell of r's fan up to the first surface, whatever its
+  // uncertainty (a surface whose weight never rises would otherwise hold its view forever).
+  void Remember(uint32_t r, const omt::RasterGeometry& g, const std::vector<omt::TaskView>& views,
+                const std::vector<int>& ids);
+  static constexpr int kRepeatLimit = 2;
+
  private:
-  std::set<std::pair<long, long>> cells_;  // global cells (floor(x / res), floor(y / res))
+  using Key = std::pair<long, long>;  // global cell (floor(x / res), floor(y / res))
+  Key KeyOf(const omt::RasterGeometry& g, int cell) const;
+  std::set<Key> cells_;
+  std::map<uint32_t, std::vector<Key>> given_;  // per robot: targets of its last tasks
+  std::map<Key, int> taken_;                    // per target: views of it taken so far
 };
 
 // options.omt with this world's robot radius.

@@ -73,7 +73,10 @@ class OmtPlanner : public vp::Planner {
       return;
     }
     vp::StageTimer timer(world, out, "output");
-    for (uint32_t r = 0; r < in.robots.size(); ++r) Emit(in, result, r, out);
+    for (uint32_t r = 0; r < in.robots.size(); ++r) {
+      Emit(in, result, r, out);
+      settled_.Remember(r, in.raster.geometry, result.views, result.robots[r].tasks);
+    }
   }
 
  private:
