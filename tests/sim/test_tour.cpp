@@ -60,6 +60,16 @@ float ElevationDeg(const Pose3f& T_W_C) {
 }
 
 // Widest gap between the camera headings of `frames`, around the circle (360 when empty).
+// The tour's frames at viewpoint v (within 0.1 mm) whose elevation is pitch_deg.
+std::vector<Pose3f> FramesAt(const Tour& tour, const Eigen::Vector2f& v, float pitch_deg) {
+  std::vector<Pose3f> frames;
+  for (const Pose3f& T : tour.T_W_C)
+    if ((T.translation().head<2>() - v).norm() < 1e-4f &&
+        std::abs(ElevationDeg(T) - pitch_deg) < kStepTolerance)
+      frames.push_back(T);
+  return frames;
+}
+
 float WidestHeadingGapDeg(const std::vector<Pose3f>& frames) {
   std::vector<float> headings;
   for (const Pose3f& T : frames) headings.push_back(HeadingDeg(T));
@@ -110,11 +120,7 @@ TEST(Tour, VisitsEveryRoomWithCollisionFreeFrames) {
   // than one step.
   for (const Eigen::Vector2f& v : tour->viewpoints_W)
     for (const float pitch_deg : params.spin_pitches_deg) {
-      std::vector<Pose3f> frames;
-      for (const Pose3f& T : tour->T_W_C)
-        if ((T.translation().head<2>() - v).norm() < 1e-4f &&
-            std::abs(ElevationDeg(T) - pitch_deg) < kStepTolerance)
-          frames.push_back(T);
+      const std::vector<Pose3f> frames = FramesAt(*tour, v, pitch_deg);
       ASSERT_GE(frames.size(), size_t(360.f / params.frame_step_deg)) << pitch_deg;
       EXPECT_LE(WidestHeadingGapDeg(frames), params.frame_step_deg + kStepTolerance)
           << v.transpose() << " at pitch " << pitch_deg;
@@ -140,17 +146,9 @@ TEST(Tour, SpinsAtEachPitchAndDrivesAtTheDrivingPitch) {
   };
   for (const Eigen::Vector2f& v : tour->viewpoints_W) {
     // No level spin was asked for: no full turn at pitch 0.
-    std::vector<Pose3f> level;
-    for (const Pose3f& T : tour->T_W_C)
-      if ((T.translation().head<2>() - v).norm() < 1e-4f && std::abs(ElevationDeg(T)) < 1e-3f)
-        level.push_back(T);
-    EXPECT_GT(WidestHeadingGapDeg(level), 90.f) << v.transpose();
+    EXPECT_GT(WidestHeadingGapDeg(FramesAt(*tour, v, 0.f)), 90.f) << v.transpose();
     for (const float pitch_deg : params.spin_pitches_deg) {
-      std::vector<Pose3f> frames;
-      for (const Pose3f& T : tour->T_W_C)
-        if ((T.translation().head<2>() - v).norm() < 1e-4f &&
-            std::abs(ElevationDeg(T) - pitch_deg) < kStepTolerance)
-          frames.push_back(T);
+      const std::vector<Pose3f> frames = FramesAt(*tour, v, pitch_deg);
       EXPECT_LE(WidestHeadingGapDeg(frames), params.frame_step_deg + kStepTolerance)
           << v.transpose() << " at pitch " << pitch_deg;
     }
