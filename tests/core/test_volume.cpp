@@ -41,7 +41,7 @@ TEST(Queries, InterpolationAndGradientAreExactOnALinearField) {
           block.r[i] = 200;
         }
       }
-  for (const Eigen::Vector3f p :
+  for (const Eigen::Vector3f& p :
        {Eigen::Vector3f(0.013f, -0.021f, 0.0f), Eigen::Vector3f(-0.1f, 0.05f, -0.033f)}) {
     const auto v = Interpolate(volume, p);
     ASSERT_TRUE(v.has_value());

@@ -68,10 +68,12 @@ TEST(ShadingTest, ShadedSphereSilhouetteCentreAndFalloff) {
   for (int v = 0; v < kHeight; ++v) {
     for (int u = 0; u < kWidth; ++u) {
       const float d = s.DistancePx(u, v);
-      if (d > s.SilhouetteRadiusPx() + 2.0f)
+      if (d > s.SilhouetteRadiusPx() + 2.0f) {
         ASSERT_EQ(rgb.at(u, v), params.background) << u << "," << v;
-      if (d < s.SilhouetteRadiusPx() - 2.0f)
+      }
+      if (d < s.SilhouetteRadiusPx() - 2.0f) {
         ASSERT_NE(rgb.at(u, v), params.background) << u << "," << v;
+      }
     }
   }
   // The headlight meets the centre head-on: brightest there (neutral grey * (ambient +
