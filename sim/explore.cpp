@@ -21,8 +21,9 @@ namespace {
 constexpr float kPi = std::numbers::pi_v<float>;
 constexpr uint32_t kPathOnlyTag = 0xffffffffu;  // a task made for a path given without tasks
 
-float Deg2Rad(float deg) { return deg * kPi / 180.f; }
+// Into [-π, π]: a turn of exactly ±π keeps its sign (the way the robot turns around).
 float WrapAngle(float a) { return std::remainder(a, 2.f * kPi); }
+
 float Clamp(float v, float limit) { return std::clamp(v, -limit, limit); }
 
 double NowMs() {

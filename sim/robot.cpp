@@ -12,8 +12,6 @@ namespace {
 
 constexpr float kPi = std::numbers::pi_v<float>;
 
-float Deg2Rad(float deg) { return deg * kPi / 180.f; }
-
 // Wraps an angle difference into (-π, π].
 float WrapAngle(float a) {
   a = std::remainder(a, 2.f * kPi);

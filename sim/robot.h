@@ -6,6 +6,7 @@
 // Motion is checked against the world's true FloorPlan and timed on a simulation clock.
 #include <Eigen/Core>
 #include <cstdint>
+#include <numbers>
 #include <string>
 
 #include "core/camera.h"
@@ -14,6 +15,8 @@
 #include "sim/floor_plan.h"
 
 namespace voxplan {
+
+inline float Deg2Rad(float deg) { return deg * std::numbers::pi_v<float> / 180.f; }
 
 enum class RobotMode { kExplorer, kReconstructor };
 const char* RobotModeName(RobotMode mode);  // "explorer", "reconstructor"

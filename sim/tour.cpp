@@ -16,8 +16,6 @@ namespace {
 constexpr float kPi = std::numbers::pi_v<float>;
 constexpr float kInf = std::numeric_limits<float>::infinity();
 
-float Deg2Rad(float deg) { return deg * kPi / 180.f; }
-
 // The plan as a graph of cells where the robot fits. "Fit" uses the footprint inflated by 0.75
 // cell: then the straight move between two 8-neighbour fit cells (and any segment whose samples,
 // half a cell apart, each round to a fit cell) keeps the real footprint free.
