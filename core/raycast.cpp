@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <bit>
 #include <cmath>
+#include <cstddef>
+#include <cstring>
 #include <limits>
 #include <vector>
 
@@ -12,14 +14,25 @@
 #if defined(__SSE2__)
 #include <emmintrin.h>
 #endif
+// Packets of 8 rays marched in AVX2 lanes, chosen at run time where the CPU has AVX2 (the
+// define: build without them).
+#if defined(__x86_64__) && defined(__GNUC__) && !defined(VOXPLAN_RAYCAST_NO_AVX2)
+#include <immintrin.h>
+#define VOXPLAN_RAYCAST_AVX2 1
+#define VOXPLAN_TARGET_AVX2 __attribute__((target("avx2")))
+#else
+#define VOXPLAN_RAYCAST_AVX2 0
+#endif
 
 namespace voxplan {
 namespace {
 
-constexpr int kRangeCell = 8;    // pixels per side of a range-image cell
-constexpr int kSurfaceCell = 2;  // pixels per side of a surface-range cell
-constexpr int kTile = 16;        // pixels per side of one parallel work item
-constexpr int kLanes = 4;        // rays a worker marches interleaved
+constexpr int kRangeCell = 8;      // pixels per side of a range-image cell
+constexpr int kSurfaceCell = 2;    // pixels per side of a surface-range cell
+constexpr int kTile = 16;          // pixels per side of one parallel work item
+constexpr int kLanes = 4;          // rays the scalar march interleaves
+constexpr int kPacket = 8;         // rays an AVX2 packet marches
+constexpr int kTilesPerBatch = 4;  // tiles whose rays feed one march (fewer idle lanes at the end)
 // Step as a fraction of the stored distance: the nearest voxel's centre can be up to 0.87 voxel
 // from the sample, and the negative band behind a surface is what catches an overshoot.
 constexpr float kStepScale = 0.9f;
@@ -256,6 +269,10 @@ RangeImage BuildRangeImage(const TsdfVolume& volume, const PinholeCamera& camera
 
 using raycast_detail::kCornerOffset;
 
+// Read where a ray has no block: never observed.
+const TsdfBlock kNoBlock{};
+constexpr int32_t kWeightOffset = int32_t(offsetof(TsdfBlock, weight));
+
 // The 2x2x2 voxel centres around a point, for trilinear interpolation of TSDF, colour and the
 // gradient. Corner k is offset (k & 1, (k >> 1) & 1, k >> 2).
 struct Cell {
@@ -277,6 +294,12 @@ struct Cell {
   }
 };
 
+// a == b without a branch per coordinate: neighbouring rays' blocks often share x or y, which
+// makes a short-circuit compare mispredict.
+inline bool SameBlock(BlockIndex a, BlockIndex b) {
+  return ((a.x ^ b.x) | (a.y ^ b.y) | (a.z ^ b.z)) == 0;
+}
+
 // Block lookups for one worker: a small direct-mapped cache (misses included) in front of the
 // hash map, since neighbouring rays visit the same blocks.
 class BlockCache {
@@ -287,7 +310,7 @@ class BlockCache {
     const uint32_t hash =
         uint32_t(b.x) * 0x8da6b343u ^ uint32_t(b.y) * 0xd8163841u ^ uint32_t(b.z) * 0xcb1ab31fu;
     Entry& e = entries_[hash >> (32 - kCacheBits)];
-    if (!(e.index == b)) {
+    if (!SameBlock(e.index, b)) {
       e.index = b;
       // Indices beyond the packable range would alias in the hash map; none is allocated.
       e.block = InPackRange(b) ? volume_.FindBlock(b) : nullptr;
@@ -319,12 +342,15 @@ class Sampler {
   // The last block looked up (by the march or a gather) first: a refinement mostly reads the
   // block the march just sampled.
   const TsdfBlock* Find(BlockIndex b) {
-    if (!(b == last_index_)) {
+    if (!SameBlock(b, last_index_)) {
       last_index_ = b;
       last_block_ = cache_.Find(b);
     }
     return last_block_;
   }
+  uint32_t min_weight_fixed() const { return min_weight_fixed_; }
+  // Find without the last-block shortcut, for lookups that alternate between rays.
+  const TsdfBlock* FindUncached(BlockIndex b) { return cache_.Find(b); }
   bool Observed(const TsdfBlock& block, int i) const {
     return uint32_t(block.weight[i]) >= min_weight_fixed_;
   }
@@ -332,7 +358,7 @@ class Sampler {
   // Points `cell` at p_W, reading the corners only when p_W left the cell it held. Unobserved
   // corners take the interpolation-weighted mean of the observed ones; returns whether all
   // eight were observed.
-  bool Gather(const Eigen::Vector3f& p_W, Cell* cell) {
+  [[gnu::always_inline]] bool Gather(const Eigen::Vector3f& p_W, Cell* cell) {
     // The cell's corner 0 and the position inside it, in voxel units.
 #if VOXPLAN_RAYCAST_SSE2
     const __m128 q =
@@ -368,8 +394,21 @@ class Sampler {
       cell->block[0] = block;
       cell->index[0] = i0;
       if (block) observed = raycast_detail::LoadCorners(*block, i0, min_weight_fixed_, cell->tsdf);
-    } else {
+      cell->observed = uint8_t(observed);
+      if (cell->complete()) return true;
+    }
+    return GatherRest(cell);
+  }
+
+  // Gather's other cases, out of line: corners across block faces, unobserved corners.
+  [[gnu::noinline]] bool GatherRest(Cell* cell) {
+    const GlobalVoxelIndex g{cell->base[0], cell->base[1], cell->base[2]};
+    const VoxelIndex local = LocalOf(g);
+    const BlockIndex b0 = BlockOf(g);
+    unsigned observed = cell->observed;  // set by Gather in one block
+    if (!(local.x < kBlockMask && local.y < kBlockMask && local.z < kBlockMask)) {
       // Corners across block faces: look up only the neighbours they reach (two usually).
+      observed = 0;
       const bool ex = local.x == kBlockMask, ey = local.y == kBlockMask, ez = local.z == kBlockMask;
       const TsdfBlock* neighbour[8] = {};
       neighbour[0] = Find(b0);
@@ -482,6 +521,50 @@ struct Ray {
   RayResult result;
 };
 
+#if VOXPLAN_RAYCAST_AVX2
+// Small AVX2 helpers of the packet march (functions, since lambdas would not get its target).
+namespace avx2 {
+VOXPLAN_TARGET_AVX2 inline __m256i Load(const void* p) {
+  return _mm256_loadu_si256(static_cast<const __m256i*>(p));
+}
+VOXPLAN_TARGET_AVX2 inline __m256 LoadF(const float* p) { return _mm256_loadu_ps(p); }
+VOXPLAN_TARGET_AVX2 inline void Store(void* p, __m256i v) {
+  _mm256_storeu_si256(static_cast<__m256i*>(p), v);
+}
+VOXPLAN_TARGET_AVX2 inline __m256i AndNot(__m256i a, __m256i b) {  // ~a & b
+  return _mm256_andnot_si256(a, b);
+}
+VOXPLAN_TARGET_AVX2 inline __m256 Blend(__m256 no, __m256 yes, __m256i mask) {
+  return _mm256_blendv_ps(no, yes, _mm256_castsi256_ps(mask));
+}
+// floor(p) as Sampler::Gather and Step compute it: truncate, minus one where that rounded up.
+VOXPLAN_TARGET_AVX2 inline __m256i Floor(__m256 p) {
+  const __m256i truncated = _mm256_cvttps_epi32(p);
+  return _mm256_add_epi32(
+      truncated, _mm256_castps_si256(_mm256_cmp_ps(p, _mm256_cvtepi32_ps(truncated), _CMP_LT_OQ)));
+}
+// The linear index inside its block of each lane's voxel g.
+VOXPLAN_TARGET_AVX2 inline __m256i LinearIndex(const __m256i g[3]) {
+  const __m256i mask = _mm256_set1_epi32(kBlockMask);
+  return _mm256_add_epi32(
+      _mm256_and_si256(g[0], mask),
+      _mm256_add_epi32(_mm256_slli_epi32(_mm256_and_si256(g[1], mask), kBlockShift),
+                       _mm256_slli_epi32(_mm256_and_si256(g[2], mask), 2 * kBlockShift)));
+}
+// The 32 bits at byte offset[l] of *block[l], for 8 lanes.
+VOXPLAN_TARGET_AVX2 inline __m256i Gather32(const TsdfBlock* const block[8], __m256i offset) {
+  const __m128i lo = _mm256_i64gather_epi32(
+      nullptr, _mm256_add_epi64(Load(block), _mm256_cvtepi32_epi64(_mm256_castsi256_si128(offset))),
+      1);
+  const __m128i hi = _mm256_i64gather_epi32(
+      nullptr,
+      _mm256_add_epi64(Load(block + 4), _mm256_cvtepi32_epi64(_mm256_extracti128_si256(offset, 1))),
+      1);
+  return _mm256_set_m128i(hi, lo);
+}
+}  // namespace avx2
+#endif
+
 // A pixel whose ray has a depth range to march.
 struct RayTask {
   size_t pixel;
@@ -492,15 +575,24 @@ struct RayTask {
 
 class RayCaster {
  public:
-  RayCaster(const TsdfVolume& volume, const RaycastParams& params, const Eigen::Vector3f& origin_W)
+  // Rays start at origin_W; the ray through pixel (u, v) is d0_W + u du_W + v dv_W.
+  RayCaster(const TsdfVolume& volume, const RaycastParams& params, const Eigen::Vector3f& origin_W,
+            const Eigen::Vector3f& d0_W, const Eigen::Vector3f& du_W, const Eigen::Vector3f& dv_W)
       : sampler_(volume, params),
         params_(params),
         origin_W_(origin_W),
+        d0_W_(d0_W),
+        du_W_(du_W),
+        dv_W_(dv_W),
         origin_vox_(origin_W * sampler_.inv_voxel()),
         step_scale_(kStepScale * volume.trunc_m() / kTsdfScale) {
 #if VOXPLAN_RAYCAST_SSE2
     origin_vox_lanes_ = _mm_set_ps(0.f, origin_vox_.z(), origin_vox_.y(), origin_vox_.x());
 #endif
+  }
+
+  Eigen::Vector3f Direction(const RayTask& task) const {
+    return d0_W_ + float(task.u) * du_W_ + float(task.v) * dv_W_;
   }
 
   // Starts marching the ray p(z) = origin + z * dir_W from z_begin to z_end.
@@ -546,7 +638,7 @@ class RayCaster {
 #else
     const Eigen::Vector3f p = origin_vox_ + ray.z * ray.dir_vox;
     const GlobalVoxelIndex g{FloorToInt(p.x()), FloorToInt(p.y()), FloorToInt(p.z())};
-    if (!(BlockOf(g) == ray.block_index)) {
+    if (!SameBlock(BlockOf(g), ray.block_index)) {
       ray.block_index = BlockOf(g);
       ray.block = sampler_.Find(ray.block_index);
     }
@@ -590,14 +682,8 @@ class RayCaster {
         ray.z += ray.voxel_z;
         return false;
       }
-      if (Refine(ray.dir_W, ray.prev_z, ray.z, DecodeTsdf(ray.prev_tsdf), DecodeTsdf(tsdf),
-                 ray.voxel_z, &ray.result)) {
-        if (ray.result.z < params_.min_depth_m || ray.result.z > params_.max_depth_m) {
-          ray.result = RayResult{};
-          ray.result.status = RayStatus::kFree;
-        }
+      if (Cross(ray.dir_W, ray.prev_z, ray.z, ray.prev_tsdf, tsdf, ray.voxel_z, &ray.result))
         return true;
-      }
       // The nearest values disagree with the interpolant (noise): keep marching.
     }
     ray.have_prev = true;
@@ -606,6 +692,225 @@ class RayCaster {
     ray.z += std::max(float(tsdf) * ray.step_scale_z, ray.voxel_z);
     return false;
   }
+
+  // Marches the tasks' rays a sample at a time, kLanes of them interleaved so that their memory
+  // latencies overlap; write(pixel, result, dir_W) receives each ray's result.
+  template <class Write>
+  void MarchInterleaved(const RayTask* tasks, size_t num_tasks, Write&& write) {
+    size_t next = 0;
+    auto start_next = [&](Ray* ray) {
+      if (next == num_tasks) return false;
+      const RayTask& task = tasks[next++];
+      Start(Direction(task), task.z_begin, task.z_end, ray);
+      ray->z_restart = task.z_restart;
+      ray->pixel = task.pixel;
+      return true;
+    };
+    Ray rays[kLanes];
+    bool live[kLanes];
+    int num_live = 0;
+    for (int l = 0; l < kLanes; ++l) num_live += (live[l] = start_next(&rays[l]));
+    while (num_live > 0)
+      for (int l = 0; l < kLanes; ++l) {
+        if (!live[l] || !Step(rays[l])) continue;
+        if (rays[l].result.status != RayStatus::kHit && rays[l].z_restart >= 0.f) {
+          // A miss after skipping free space: march the whole range, so the status says
+          // whether the ray met observed space.
+          const float z_restart = rays[l].z_restart;
+          Start(rays[l].dir_W, z_restart, rays[l].z_end, &rays[l]);
+          rays[l].z_restart = -1.f;
+          continue;
+        }
+        write(rays[l].pixel, rays[l].result, rays[l].dir_W);
+        if (!start_next(&rays[l])) live[l] = false, --num_live;
+      }
+  }
+
+#if VOXPLAN_RAYCAST_AVX2
+  // The same march over packets of kPacket rays in AVX2 lanes: every lane takes the sample Step
+  // would take, with the same float operations in the same order (no FMA: the file is built
+  // with -ffp-contract=off), so the images are identical to MarchInterleaved's. The steps have
+  // no per-ray branch; block lookups, crossings (Refine, scalar: gathering its cells lane by
+  // lane measured no faster on AVX2) and new rays are handled lane by lane.
+  template <class Write>
+  VOXPLAN_TARGET_AVX2 void MarchPackets(const RayTask* tasks, size_t num_tasks, Write&& write) {
+    struct alignas(32) Lanes {
+      float z[kPacket], z_end[kPacket], voxel_z[kPacket], step_z[kPacket], prev_z[kPacket];
+      float dir_vox[3][kPacket], dir_W[3][kPacket];
+      int32_t block_index[3][kPacket];
+      int32_t prev_tsdf[kPacket], tsdf[kPacket];
+      int32_t live[kPacket], has_block[kPacket], have_prev[kPacket], met[kPacket];  // 0 or -1
+      const TsdfBlock* block[kPacket];
+      size_t pixel[kPacket];
+      float z_restart[kPacket];
+    } lanes;
+    std::memset(&lanes, 0, sizeof(lanes));
+    for (auto& block : lanes.block) block = &kNoBlock;
+    // Starts lane l's march of the ray through `pixel` from z_begin to z_end.
+    auto start = [&](int l, const Eigen::Vector3f& dir_W, float z_begin, float z_end,
+                     float z_restart, size_t pixel) {
+      Ray ray;
+      Start(dir_W, z_begin, z_end, &ray);
+      const Eigen::Vector3f dir_vox = dir_W * sampler_.inv_voxel();  // as Start computes it
+      lanes.z[l] = ray.z, lanes.z_end[l] = ray.z_end;
+      lanes.voxel_z[l] = ray.voxel_z, lanes.step_z[l] = ray.step_scale_z;
+      for (int a = 0; a < 3; ++a) {
+        lanes.dir_vox[a][l] = dir_vox[a];
+        lanes.dir_W[a][l] = dir_W[a];
+        lanes.block_index[a][l] = (&ray.block_index.x)[a];
+      }
+      lanes.live[l] = -1, lanes.has_block[l] = 0, lanes.have_prev[l] = 0, lanes.met[l] = 0;
+      lanes.block[l] = &kNoBlock;
+      lanes.pixel[l] = pixel;
+      lanes.z_restart[l] = z_restart;
+    };
+    size_t next = 0;
+    auto start_next = [&](int l) {
+      if (next == num_tasks) {
+        lanes.live[l] = 0;
+        lanes.block[l] = &kNoBlock;
+        return false;
+      }
+      const RayTask& task = tasks[next++];
+      start(l, Direction(task), task.z_begin, task.z_end, task.z_restart, task.pixel);
+      return true;
+    };
+    // Lane l's ray ended with `result`: march the whole range again when it skipped free space
+    // and did not hit (so the status says whether it met observed space), else write it and
+    // start the next ray. False when the lane is left without a ray.
+    auto finish = [&](int l, const Eigen::Vector3f& dir_W, const RayResult& result) {
+      if (result.status != RayStatus::kHit && lanes.z_restart[l] >= 0.f) {
+        start(l, dir_W, lanes.z_restart[l], lanes.z_end[l], -1.f, lanes.pixel[l]);
+        return true;
+      }
+      write(lanes.pixel[l], result, dir_W);
+      return start_next(l);
+    };
+    int num_live = 0;
+    for (int l = 0; l < kPacket; ++l) num_live += start_next(l);
+
+    const __m256 origin_vox[3] = {_mm256_set1_ps(origin_vox_.x()), _mm256_set1_ps(origin_vox_.y()),
+                                  _mm256_set1_ps(origin_vox_.z())};
+    const __m256 origin_W[3] = {_mm256_set1_ps(origin_W_.x()), _mm256_set1_ps(origin_W_.y()),
+                                _mm256_set1_ps(origin_W_.z())};
+    const __m256 block_m = _mm256_set1_ps(sampler_.voxel_m() * kBlockSide);
+    const __m256 inf = _mm256_set1_ps(std::numeric_limits<float>::infinity());
+    const __m256i zero = _mm256_setzero_si256(), minus_one = _mm256_set1_epi32(-1);
+    const __m256i min_weight_minus_one =
+        _mm256_set1_epi32(int32_t(sampler_.min_weight_fixed()) - 1);
+    const __m256i stop_at_back_faces = params_.stop_at_back_faces ? minus_one : zero;
+
+    while (num_live > 0) {
+      const __m256i live = avx2::Load(lanes.live);
+      const __m256 z = avx2::LoadF(lanes.z);
+      const __m256i in_range = _mm256_and_si256(
+          live, _mm256_castps_si256(_mm256_cmp_ps(z, avx2::LoadF(lanes.z_end), _CMP_LE_OQ)));
+      // The sample's voxel and block, as Step computes them.
+      __m256i g[3], changed = zero;
+      for (int a = 0; a < 3; ++a) {
+        const __m256 p =
+            _mm256_add_ps(origin_vox[a], _mm256_mul_ps(z, avx2::LoadF(lanes.dir_vox[a])));
+        g[a] = avx2::Floor(p);
+        const __m256i b = _mm256_srai_epi32(g[a], kBlockShift);
+        changed = _mm256_or_si256(
+            changed,
+            avx2::AndNot(_mm256_cmpeq_epi32(b, avx2::Load(lanes.block_index[a])), minus_one));
+        avx2::Store(lanes.block_index[a], b);  // lanes out of range never read it again
+      }
+      changed = _mm256_and_si256(changed, in_range);
+      for (int bits = _mm256_movemask_ps(_mm256_castsi256_ps(changed)); bits; bits &= bits - 1) {
+        const int l = std::countr_zero(unsigned(bits));
+        const TsdfBlock* block = sampler_.FindUncached(
+            BlockIndex{lanes.block_index[0][l], lanes.block_index[1][l], lanes.block_index[2][l]});
+        lanes.has_block[l] = block ? -1 : 0;
+        lanes.block[l] = block ? block : &kNoBlock;
+      }
+      // tsdf[i] and weight[i] of each lane's block (two bytes more are read, inside the block).
+      const __m256i i = avx2::LinearIndex(g);
+      const __m256i offset_tsdf = _mm256_add_epi32(i, i);
+      const __m256i tsdf =
+          _mm256_srai_epi32(_mm256_slli_epi32(avx2::Gather32(lanes.block, offset_tsdf), 16), 16);
+      const __m256i weight = _mm256_and_si256(
+          avx2::Gather32(lanes.block,
+                         _mm256_add_epi32(offset_tsdf, _mm256_set1_epi32(kWeightOffset))),
+          _mm256_set1_epi32(0xffff));
+
+      const __m256i has_block = avx2::Load(lanes.has_block);
+      const __m256i no_block = avx2::AndNot(has_block, in_range);
+      const __m256i observed = _mm256_and_si256(_mm256_and_si256(in_range, has_block),
+                                                _mm256_cmpgt_epi32(weight, min_weight_minus_one));
+      const __m256i unobserved = avx2::AndNot(observed, _mm256_and_si256(in_range, has_block));
+      const __m256i have_prev = avx2::Load(lanes.have_prev);
+      const __m256i prev_tsdf = avx2::Load(lanes.prev_tsdf);
+      const __m256i tsdf_nonneg = _mm256_cmpgt_epi32(tsdf, minus_one);
+      const __m256i cross =
+          _mm256_and_si256(_mm256_and_si256(observed, have_prev),
+                           _mm256_xor_si256(_mm256_cmpgt_epi32(prev_tsdf, minus_one), tsdf_nonneg));
+      const __m256i back_face = _mm256_and_si256(cross, tsdf_nonneg);
+      const __m256i stop = _mm256_and_si256(back_face, stop_at_back_faces);
+      const __m256i front_face = avx2::AndNot(tsdf_nonneg, cross);  // refined below
+      const __m256i advance = avx2::AndNot(cross, observed);
+      const __m256i one_voxel = _mm256_or_si256(unobserved, avx2::AndNot(stop, back_face));
+
+      // Where a lane without a block leaves it (nudged past the face).
+      __m256 z_exit = inf;
+      for (int a = 0; a < 3; ++a) {
+        const __m256 d = avx2::LoadF(lanes.dir_W[a]);
+        const __m256i face = _mm256_sub_epi32(
+            avx2::Load(lanes.block_index[a]),
+            _mm256_castps_si256(_mm256_cmp_ps(d, _mm256_setzero_ps(), _CMP_GT_OQ)));
+        __m256 t = _mm256_div_ps(
+            _mm256_sub_ps(_mm256_mul_ps(_mm256_cvtepi32_ps(face), block_m), origin_W[a]), d);
+        t = _mm256_blendv_ps(t, inf, _mm256_cmp_ps(d, _mm256_setzero_ps(), _CMP_EQ_OQ));
+        z_exit = _mm256_min_ps(t, z_exit);
+      }
+      const __m256 voxel_z = avx2::LoadF(lanes.voxel_z);
+      const __m256 tsdf_f = _mm256_cvtepi32_ps(tsdf);
+      __m256 z_next = z;
+      z_next = avx2::Blend(
+          z_next,
+          _mm256_add_ps(_mm256_max_ps(z, z_exit), _mm256_mul_ps(_mm256_set1_ps(0.01f), voxel_z)),
+          no_block);
+      z_next = avx2::Blend(z_next, _mm256_add_ps(z, voxel_z), one_voxel);
+      z_next = avx2::Blend(
+          z_next,
+          _mm256_add_ps(z,
+                        _mm256_max_ps(voxel_z, _mm256_mul_ps(tsdf_f, avx2::LoadF(lanes.step_z)))),
+          advance);
+      _mm256_storeu_ps(lanes.z, z_next);
+      _mm256_storeu_ps(lanes.prev_z, avx2::Blend(avx2::LoadF(lanes.prev_z), z, advance));
+      avx2::Store(lanes.prev_tsdf, _mm256_blendv_epi8(prev_tsdf, tsdf, advance));
+      avx2::Store(lanes.tsdf, tsdf);
+      // have_prev: set by an advance, cleared by a jump or a one-voxel step, kept otherwise.
+      const __m256i cleared = _mm256_or_si256(no_block, one_voxel);
+      avx2::Store(lanes.have_prev, _mm256_or_si256(advance, avx2::AndNot(cleared, have_prev)));
+      avx2::Store(lanes.met, _mm256_or_si256(avx2::Load(lanes.met), observed));
+
+      const __m256i done =
+          _mm256_or_si256(avx2::AndNot(in_range, live), _mm256_or_si256(stop, front_face));
+      const int front_bits = _mm256_movemask_ps(_mm256_castsi256_ps(front_face));
+      for (int bits = _mm256_movemask_ps(_mm256_castsi256_ps(done)); bits; bits &= bits - 1) {
+        const int l = std::countr_zero(unsigned(bits));
+        const Eigen::Vector3f dir_W(lanes.dir_W[0][l], lanes.dir_W[1][l], lanes.dir_W[2][l]);
+        RayResult result;
+        if (lanes.met[l]) result.status = RayStatus::kFree;
+        if (((front_bits >> l) & 1) &&
+            !Cross(dir_W, lanes.prev_z[l], lanes.z[l], int16_t(lanes.prev_tsdf[l]),
+                   int16_t(lanes.tsdf[l]), lanes.voxel_z[l], &result)) {
+          // The nearest values disagree with the interpolant (noise): march on, as Step does.
+          const int16_t tsdf = int16_t(lanes.tsdf[l]);
+          lanes.have_prev[l] = -1;
+          lanes.prev_z[l] = lanes.z[l];
+          lanes.prev_tsdf[l] = tsdf;
+          lanes.z[l] += std::max(float(tsdf) * lanes.step_z[l], lanes.voxel_z[l]);
+          continue;
+        }
+        num_live -= !finish(l, dir_W, result);
+      }
+    }
+  }
+
+#endif
 
  private:
   bool Sample(const Eigen::Vector3f& dir_W, float z, Cell* cell, float* tsdf,
@@ -697,9 +1002,23 @@ class RayCaster {
     return true;
   }
 
+  // The nearest voxels changed sign from tsdf_a >= 0 at z_a to tsdf_b < 0 at z_b: true with
+  // the refined hit (or kFree when it lies outside the depth limits), false when the
+  // interpolant has no zero there.
+  bool Cross(const Eigen::Vector3f& dir_W, float z_a, float z_b, int16_t tsdf_a, int16_t tsdf_b,
+             float voxel_z, RayResult* result) {
+    if (!Refine(dir_W, z_a, z_b, DecodeTsdf(tsdf_a), DecodeTsdf(tsdf_b), voxel_z, result))
+      return false;
+    if (result->z < params_.min_depth_m || result->z > params_.max_depth_m) {
+      *result = RayResult{};
+      result->status = RayStatus::kFree;
+    }
+    return true;
+  }
+
   Sampler sampler_;
   RaycastParams params_;
-  Eigen::Vector3f origin_W_, origin_vox_;
+  Eigen::Vector3f origin_W_, d0_W_, du_W_, dv_W_, origin_vox_;
 #if VOXPLAN_RAYCAST_SSE2
   __m128 origin_vox_lanes_;
 #endif
@@ -756,67 +1075,54 @@ void Raycast(const TsdfVolume& volume, const PinholeCamera& camera, const Pose3f
     }
   };
 
-  ParallelFor(size_t(tiles_x) * size_t(tiles_y), 4, [&](size_t begin, size_t end) {
-    RayCaster caster(volume, params, origin_W);
+#if VOXPLAN_RAYCAST_AVX2
+  static const bool cpu_has_avx2 = __builtin_cpu_supports("avx2");
+  const bool packets = params.simd && cpu_has_avx2;
+#endif
+  ParallelFor(size_t(tiles_x) * size_t(tiles_y), kTilesPerBatch, [&](size_t begin, size_t end) {
+    RayCaster caster(volume, params, origin_W, d0_W, du_W, dv_W);
     const RayResult unobserved;
-    for (size_t tile = begin; tile < end; ++tile) {
-      const int u0 = int(tile % size_t(tiles_x)) * kTile, v0 = int(tile / size_t(tiles_x)) * kTile;
-      const int u_end = std::min(u0 + kTile, w), v_end = std::min(v0 + kTile, h);
-      // First the tile's pixels whose rays have a range to march, row by row; the others
-      // are written as unobserved at once.
-      RayTask tasks[kTile * kTile];
-      int num_tasks = 0;
-      for (int v = v0; v < v_end; ++v) {
-        const size_t range_row = size_t(v / kRangeCell) * size_t(range.cols);
-        const size_t surface_row = size_t(v / kSurfaceCell) * size_t(range.surface_cols);
-        for (int u = u0; u < u_end; ++u) {
-          const size_t px = size_t(v) * size_t(w) + size_t(u);
-          if (usable) {
-            const size_t cell = range_row + size_t(u / kRangeCell);
-            const float z_all = std::max(range.z_min[cell], z_start);
-            const float z_end = std::min(range.z_max[cell], params.max_depth_m);
-            if (z_all <= z_end) {
-              // Start just in front of the nearest cube of a negative voxel: no crossing can
-              // end before it.
-              const float z_surface = std::max(
-                  range.surface_z_min[surface_row + size_t(u / kSurfaceCell)] - surface_margin,
-                  z_all);
-              const bool skip = z_surface <= z_end && z_surface > z_all;
-              tasks[num_tasks++] = {px, u, v, skip ? z_surface : z_all, z_end, skip ? z_all : -1.f};
-              continue;
+    RayTask tasks[kTilesPerBatch * kTile * kTile];
+    for (size_t first = begin; first < end; first += kTilesPerBatch) {
+      // First the pixels whose rays have a range to march, tile by tile and row by row; the
+      // others are written as unobserved at once.
+      size_t num_tasks = 0;
+      for (size_t tile = first; tile < std::min(first + kTilesPerBatch, end); ++tile) {
+        const int u0 = int(tile % size_t(tiles_x)) * kTile,
+                  v0 = int(tile / size_t(tiles_x)) * kTile;
+        const int u_end = std::min(u0 + kTile, w), v_end = std::min(v0 + kTile, h);
+        for (int v = v0; v < v_end; ++v) {
+          const size_t range_row = size_t(v / kRangeCell) * size_t(range.cols);
+          const size_t surface_row = size_t(v / kSurfaceCell) * size_t(range.surface_cols);
+          for (int u = u0; u < u_end; ++u) {
+            const size_t px = size_t(v) * size_t(w) + size_t(u);
+            if (usable) {
+              const size_t cell = range_row + size_t(u / kRangeCell);
+              const float z_all = std::max(range.z_min[cell], z_start);
+              const float z_end = std::min(range.z_max[cell], params.max_depth_m);
+              if (z_all <= z_end) {
+                // Start just in front of the nearest cube of a negative voxel: no crossing can
+                // end before it.
+                const float z_surface = std::max(
+                    range.surface_z_min[surface_row + size_t(u / kSurfaceCell)] - surface_margin,
+                    z_all);
+                const bool skip = z_surface <= z_end && z_surface > z_all;
+                tasks[num_tasks++] = {
+                    px, u, v, skip ? z_surface : z_all, z_end, skip ? z_all : -1.f};
+                continue;
+              }
             }
+            write(px, unobserved, d0_W);
           }
-          write(px, unobserved, d0_W);
         }
       }
-      int next = 0;
-      auto start_next = [&](Ray* ray) {
-        if (next == num_tasks) return false;
-        const RayTask& task = tasks[next++];
-        caster.Start(d0_W + float(task.u) * du_W + float(task.v) * dv_W, task.z_begin, task.z_end,
-                     ray);
-        ray->z_restart = task.z_restart;
-        ray->pixel = task.pixel;
-        return true;
-      };
-      Ray rays[kLanes];
-      bool live[kLanes];
-      int num_live = 0;
-      for (int l = 0; l < kLanes; ++l) num_live += (live[l] = start_next(&rays[l]));
-      while (num_live > 0)
-        for (int l = 0; l < kLanes; ++l) {
-          if (!live[l] || !caster.Step(rays[l])) continue;
-          if (rays[l].result.status != RayStatus::kHit && rays[l].z_restart >= 0.f) {
-            // A miss after skipping free space: march the whole range, so the status says
-            // whether the ray met observed space.
-            const float z_restart = rays[l].z_restart;
-            caster.Start(rays[l].dir_W, z_restart, rays[l].z_end, &rays[l]);
-            rays[l].z_restart = -1.f;
-            continue;
-          }
-          write(rays[l].pixel, rays[l].result, rays[l].dir_W);
-          if (!start_next(&rays[l])) live[l] = false, --num_live;
-        }
+#if VOXPLAN_RAYCAST_AVX2
+      if (packets) {
+        caster.MarchPackets(tasks, num_tasks, write);
+        continue;
+      }
+#endif
+      caster.MarchInterleaved(tasks, num_tasks, write);
     }
   });
 }
