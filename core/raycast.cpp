@@ -1076,8 +1076,7 @@ void Raycast(const TsdfVolume& volume, const PinholeCamera& camera, const Pose3f
   };
 
 #if VOXPLAN_RAYCAST_AVX2
-  static const bool cpu_has_avx2 = __builtin_cpu_supports("avx2");
-  const bool packets = params.simd && cpu_has_avx2;
+  const bool packets = params.simd && RaycastSimdAvailable();
 #endif
   ParallelFor(size_t(tiles_x) * size_t(tiles_y), kTilesPerBatch, [&](size_t begin, size_t end) {
     RayCaster caster(volume, params, origin_W, d0_W, du_W, dv_W);
@@ -1125,6 +1124,15 @@ void Raycast(const TsdfVolume& volume, const PinholeCamera& camera, const Pose3f
       caster.MarchInterleaved(tasks, num_tasks, write);
     }
   });
+}
+
+bool RaycastSimdAvailable() {
+#if VOXPLAN_RAYCAST_AVX2
+  static const bool available = __builtin_cpu_supports("avx2");
+  return available;
+#else
+  return false;
+#endif
 }
 
 RaycastImages Raycast(const TsdfVolume& volume, const PinholeCamera& camera, const Pose3f& T_W_C,

@@ -43,6 +43,9 @@ struct RaycastImages {
   Image<uint8_t> status;            // RayStatus
 };
 
+// Whether RaycastParams::simd marches AVX2 packets here (an x86-64 build on a CPU with AVX2).
+bool RaycastSimdAvailable();
+
 RaycastImages Raycast(const TsdfVolume& volume, const PinholeCamera& camera, const Pose3f& T_W_C,
                       const RaycastParams& params = {});
 // The same, into images that are reused when their size matches the camera (no allocation per

@@ -335,13 +335,16 @@ int RunBench(const BenchOptions& o, BenchMode mode) {
   const VolumeParams volume_params{float(o.voxel_size_m), float(o.trunc_m)};
   RaycastParams raycast_params;
   raycast_params.max_depth_m = float(o.in.max_depth_m);
+  raycast_params.simd = params.kernel != Kernel::kScalar;
   const char* kernel_name = KernelName(ResolveKernel(params.kernel));
+  const char* raycast_kernel_name =
+      raycast_params.simd && RaycastSimdAvailable() ? "avx2" : "scalar";
 
   std::cerr << "bench " << ModeName(mode) << ": " << info.root << " ("
             << DatasetFormatName(info.format) << "), " << indices.size() << " frames, voxel "
             << o.voxel_size_m << " m, trunc " << o.trunc_m << " m, threads " << o.threads
             << (o.threads.empty() ? "1,all" : "") << ", " << o.repeat << " repeats, kernel "
-            << kernel_name << std::endl;
+            << kernel_name << " (raycast " << raycast_kernel_name << ")" << std::endl;
 
   // Recorded on the first pass only: the frames integrated, in order.
   std::vector<FrameRecord> records;
@@ -575,6 +578,7 @@ int RunBench(const BenchOptions& o, BenchMode mode) {
   j["repeat"] = o.repeat;
   j["threads"] = *thread_list;
   j["kernel"] = kernel_name;
+  j["raycast_kernel"] = raycast_kernel_name;
   j["raycast_views"] = raycast_poses.size();
   j["raycast_pose_indexes"] = raycast_poses;
   j["camera"] = {{"width", info.camera.width},       {"height", info.camera.height},
@@ -678,7 +682,9 @@ void AddBenchOptions(CLI::App* sub, BenchOptions& o) {
   sub->add_option("--repeat", o.repeat, "Repeats per thread count (median reported)")
       ->check(CLI::Range(1, 1000))
       ->capture_default_str();
-  sub->add_option("--kernel", o.kernel, "Integration kernel")
+  sub->add_option("--kernel", o.kernel,
+                  "Integration and ray-casting kernels: scalar reference or SIMD (auto: SIMD "
+                  "where the CPU has AVX2)")
       ->check(CLI::IsMember({"auto", "scalar", "simd"}))
       ->capture_default_str();
   sub->add_flag("--vs-open3d", o.vs_open3d,

@@ -347,9 +347,7 @@ TEST(Raycast, OneAndTwoThreadsGiveIdenticalBytes) {
 // noise, unobserved voxels, varied colour), from outside and from inside a solid, with and
 // without stopping at back faces: the same bytes.
 TEST(Raycast, PacketMarchMatchesTheScalarMarchExactly) {
-#if defined(__x86_64__)
-  if (!__builtin_cpu_supports("avx2")) GTEST_SKIP() << "no AVX2: only the scalar march runs";
-#endif
+  if (!RaycastSimdAvailable()) GTEST_SKIP() << "no AVX2 packets here: only the scalar march runs";
   const Sphere sphere{Eigen::Vector3f(0.f, 0.f, 0.f), 0.3f};
   const Box box{Eigen::Vector3f(-0.6f, -0.6f, -0.5f), Eigen::Vector3f(0.6f, 0.6f, -0.4f)};
   TsdfVolume volume =

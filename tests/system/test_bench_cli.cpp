@@ -69,6 +69,7 @@ TEST(BenchCliTest, FusionOnTenIclFrames) {
                           "repeat",
                           "threads",
                           "kernel",
+                          "raycast_kernel",
                           "machine"}) {
     EXPECT_TRUE(j.contains(key)) << key;
   }

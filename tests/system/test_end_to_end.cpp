@@ -104,9 +104,7 @@ TEST(EndToEnd, IclNuimFusedMapRaycastMatchesTheInputDepth) {
 // interpolant has no zero, back faces, unobserved gaps, restarts): the same bytes. Views from
 // the checked poses and from between them, looking past the fused region too.
 TEST(EndToEnd, IclNuimRaycastPacketsMatchTheScalarMarchExactly) {
-#if defined(__x86_64__)
-  if (!__builtin_cpu_supports("avx2")) GTEST_SKIP() << "no AVX2: only the scalar march runs";
-#endif
+  if (!RaycastSimdAvailable()) GTEST_SKIP() << "no AVX2 packets here: only the scalar march runs";
   const FusedIcl& icl = FuseIcl();
   ASSERT_EQ(icl.checked.size(), 3u);
   std::vector<Pose3f> poses;
