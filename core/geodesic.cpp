@@ -2,11 +2,16 @@
 
 #include <algorithm>
 #include <array>
+#include <bit>
 #include <cmath>
 #include <limits>
 #include <utility>
 
 #include "core/parallel.h"
+
+#if defined(__SSE2__)
+#include <emmintrin.h>
+#endif
 
 namespace voxplan {
 namespace {
@@ -140,9 +145,67 @@ float DistanceField::At(int ix, int iy) const {
   return geometry.Contains(ix, iy) ? distance_m.at(ix, iy) : kInf;
 }
 
-DistanceField GeodesicField(const Image<uint8_t>& traversable, const FloorGeometry& geometry,
-                            Eigen::Vector2i source_cell, GridConnectivity connectivity) {
+namespace {
+
+// A move's bit in a cell's move mask. The bits come in groups of four whose targets are four
+// consecutive cells of one row (rows -2 .. +2, starting at x - 1, x - 2, x - 1, x - 2 and x - 1),
+// then the (2, -1) and (2, 1) knights, so the SSE path below reads each group with one load.
+constexpr int kMaskGroups = 6;
+constexpr int kMaskBits = 4 * kMaskGroups;
+int MaskBit(int dx, int dy) {
+  switch (dy) {
+    case -2:
+      return dx + 1;
+    case -1:
+      return dx == 2 ? 20 : 4 + dx + 2;
+    case 0:
+      return 8 + dx + 1;
+    case 1:
+      return dx == 2 ? 21 : 12 + dx + 2;
+    default:
+      return 16 + dx + 1;
+  }
+}
+
+// Per cell, the bit of every move (MaskBit) that stays on traversable cells (its target and
+// every cell it crosses); 0 on cells that are not traversable. One mask serves every field over
+// the same raster, and spares each Dijkstra the corner checks of every move.
+std::vector<uint32_t> MoveMasks(const Image<uint8_t>& traversable, GridConnectivity connectivity) {
+  const int w = traversable.width, h = traversable.height;
+  // A copy padded with two closed cells on every side, so no move needs a bounds check.
+  constexpr int kPad = 2;
+  const int pw = w + 2 * kPad;
+  std::vector<uint8_t> open(size_t(pw) * size_t(h + 2 * kPad), 0);
+  for (int y = 0; y < h; ++y)
+    for (int x = 0; x < w; ++x) open[size_t(y + kPad) * pw + x + kPad] = traversable.at(x, y) != 0;
+  std::vector<uint32_t> masks(size_t(w) * size_t(h), 0);
+  for (const Move& m : MovesFor(connectivity)) {
+    const ptrdiff_t to = ptrdiff_t(m.dy) * pw + m.dx;
+    // A move without vias checks its own target twice.
+    const ptrdiff_t via0 = m.num_vias ? ptrdiff_t(m.via_dy[0]) * pw + m.via_dx[0] : to;
+    const ptrdiff_t via1 = m.num_vias ? ptrdiff_t(m.via_dy[1]) * pw + m.via_dx[1] : to;
+    const int bit = MaskBit(m.dx, m.dy);
+    for (int y = 0; y < h; ++y) {
+      const uint8_t* c = &open[size_t(y + kPad) * pw + kPad];
+      uint32_t* out = &masks[size_t(y) * w];
+      for (int x = 0; x < w; ++x)
+        out[x] |= uint32_t(c[x] & c[x + to] & c[x + via0] & c[x + via1]) << bit;
+    }
+  }
+  return masks;
+}
+
+// Dijkstra over the moves `masks` allows. Distances are in cells while it runs. Every move
+// costs at least one cell, so the cells whose distance lies in [k, k + 1) are final once the
+// buckets below k are done and can be settled in any order (Dial's buckets, exact here): no
+// heap. Each distance is the least of its neighbours' plus the move, whatever the order, so the
+// field does not depend on how it was computed (nor on the SSE path). Sequential, so
+// deterministic.
+DistanceField FieldOverMoves(const std::vector<uint32_t>& masks, const Image<uint8_t>& traversable,
+                             const FloorGeometry& geometry, Eigen::Vector2i source_cell,
+                             GridConnectivity connectivity) {
   assert(traversable.width == geometry.width && traversable.height == geometry.height);
+  assert(masks.size() == traversable.data.size());
   DistanceField field;
   field.geometry = geometry;
   field.connectivity = connectivity;
@@ -153,36 +216,31 @@ DistanceField GeodesicField(const Image<uint8_t>& traversable, const FloorGeomet
     return field;
   }
   field.source_cell = source_cell;
-
-  // Dijkstra on a copy padded with two closed cells on every side, so no move needs a bounds
-  // check. Distances are in cells while it runs. Every move costs at least one cell, so the
-  // cells whose distance lies in [k, k + 1) are final once the buckets below k are done and
-  // can be settled in any order (Dial's buckets, exact here): no heap. Sequential, so
-  // deterministic.
-  constexpr int kPad = 2;
-  const int pw = geometry.width + 2 * kPad, ph = geometry.height + 2 * kPad;
-  enum : uint8_t { kClosed = 0, kOpen = 1, kSettled = 2 };
-  std::vector<uint8_t> state(size_t(pw) * size_t(ph), kClosed);
-  for (int iy = 0; iy < geometry.height; ++iy)
-    std::copy_n(&traversable.data[geometry.Linear(0, iy)], geometry.width,
-                &state[size_t(iy + kPad) * pw + kPad]);
-  struct Step {
-    ptrdiff_t offset, via0, via1;
-    float cost;
-  };
-  std::vector<Step> steps;
+  const ptrdiff_t w = geometry.width;
+  std::array<ptrdiff_t, kMaskBits> offset{};
+  std::array<float, kMaskBits> cost;
+  cost.fill(kInf);  // no move: never an improvement
   for (const Move& m : MovesFor(connectivity)) {
-    Step s{ptrdiff_t(m.dy) * pw + m.dx, 0, 0, m.cost};
-    // A move without vias checks its own target twice, which keeps the loop branch-free.
-    s.via0 = m.num_vias ? ptrdiff_t(m.via_dy[0]) * pw + m.via_dx[0] : s.offset;
-    s.via1 = m.num_vias ? ptrdiff_t(m.via_dy[1]) * pw + m.via_dx[1] : s.offset;
-    steps.push_back(s);
+    offset[size_t(MaskBit(m.dx, m.dy))] = ptrdiff_t(m.dy) * w + m.dx;
+    cost[size_t(MaskBit(m.dx, m.dy))] = m.cost;
   }
   // The longest move (sqrt 5 < 3 cells) lands at most 3 buckets ahead: 4 buckets in a ring.
   constexpr uint32_t kRing = 4;
   std::array<std::vector<uint32_t>, kRing> buckets;
-  std::vector<float> dist(state.size(), kInf);
-  const uint32_t start = uint32_t((source_cell.y() + kPad) * pw + source_cell.x() + kPad);
+  std::vector<uint8_t> settled(masks.size(), 0);
+  float* dist = field.distance_m.data.data();
+  auto improve = [&](uint32_t i, int bit, float nd) {
+    const size_t j = size_t(ptrdiff_t(i) + offset[size_t(bit)]);
+    dist[j] = nd;
+    buckets[uint32_t(nd) % kRing].push_back(uint32_t(j));
+  };
+#if defined(__SSE2__)
+  // Cells at least this far from both ends of the raster read every group in the array.
+  const size_t margin = size_t(2 * w + 2);
+  __m128 group_cost[kMaskGroups];
+  for (int g = 0; g < kMaskGroups; ++g) group_cost[g] = _mm_loadu_ps(&cost[size_t(4 * g)]);
+#endif
+  const uint32_t start = uint32_t(geometry.Linear(source_cell.x(), source_cell.y()));
   dist[start] = 0.0f;
   buckets[0].push_back(start);
   size_t pending = 1;
@@ -190,18 +248,37 @@ DistanceField GeodesicField(const Image<uint8_t>& traversable, const FloorGeomet
     std::vector<uint32_t>& bucket = buckets[k % kRing];
     for (size_t t = 0; t < bucket.size(); ++t) {
       const uint32_t i = bucket[t];
-      if (state[i] != kOpen) continue;  // settled through an earlier entry
-      state[i] = kSettled;
+      if (settled[i]) continue;  // settled through an earlier entry
+      settled[i] = 1;
       const float d = dist[i];
-      for (const Step& s : steps) {
-        const size_t j = size_t(ptrdiff_t(i) + s.offset);
-        if (!state[j] || !state[size_t(ptrdiff_t(i) + s.via0)] ||
-            !state[size_t(ptrdiff_t(i) + s.via1)])
-          continue;
-        const float nd = d + s.cost;
-        if (nd < dist[j]) {
-          dist[j] = nd;
-          buckets[uint32_t(nd) % kRing].push_back(uint32_t(j));
+#if defined(__SSE2__)
+      if (i >= margin && i + margin < masks.size()) {
+        // Which of 16 neighbours improve is hard to predict: compare them four at a time.
+        const float* p = dist + i;
+        const __m128 dv = _mm_set1_ps(d);
+        const __m128 old[kMaskGroups] = {
+            _mm_loadu_ps(p - 2 * w - 1), _mm_loadu_ps(p - w - 2),
+            _mm_loadu_ps(p - 1),         _mm_loadu_ps(p + w - 2),
+            _mm_loadu_ps(p + 2 * w - 1), _mm_set_ps(0.f, 0.f, p[w + 2], p[-w + 2])};
+        uint32_t better = 0;  // bits of the moves that shorten their target's distance
+        for (int g = 0; g < kMaskGroups; ++g) {
+          const __m128 nd = _mm_add_ps(dv, group_cost[g]);
+          better |= uint32_t(_mm_movemask_ps(_mm_cmplt_ps(nd, old[g]))) << (4 * g);
+        }
+        better &= masks[i];
+        for (; better != 0; better &= better - 1) {
+          const int bit = std::countr_zero(better);
+          improve(i, bit, d + cost[size_t(bit)]);
+          ++pending;
+        }
+        continue;
+      }
+#endif
+      for (uint32_t m = masks[i]; m != 0; m &= m - 1) {
+        const int bit = std::countr_zero(m);
+        const float nd = d + cost[size_t(bit)];
+        if (nd < dist[size_t(ptrdiff_t(i) + offset[size_t(bit)])]) {
+          improve(i, bit, nd);
           ++pending;
         }
       }
@@ -210,12 +287,16 @@ DistanceField GeodesicField(const Image<uint8_t>& traversable, const FloorGeomet
     bucket.clear();
   }
   const float cell = geometry.cell_size_m;
-  for (int iy = 0; iy < geometry.height; ++iy) {
-    const float* from = &dist[size_t(iy + kPad) * pw + kPad];
-    float* to = &field.distance_m.data[geometry.Linear(0, iy)];
-    for (int ix = 0; ix < geometry.width; ++ix) to[ix] = from[ix] * cell;
-  }
+  for (float& d : field.distance_m.data) d *= cell;
   return field;
+}
+
+}  // namespace
+
+DistanceField GeodesicField(const Image<uint8_t>& traversable, const FloorGeometry& geometry,
+                            Eigen::Vector2i source_cell, GridConnectivity connectivity) {
+  return FieldOverMoves(MoveMasks(traversable, connectivity), traversable, geometry, source_cell,
+                        connectivity);
 }
 
 std::optional<Eigen::Vector2i> SnapToTraversable(const Image<uint8_t>& traversable,
@@ -282,6 +363,7 @@ void GeodesicCache::Clear() {
   synced_ = false;
   fields_.clear();
   traversable_ = {};
+  moves_ = {};
 }
 
 void GeodesicCache::Sync(const FloorMap& map, const GeodesicParams& params) {
@@ -293,6 +375,7 @@ void GeodesicCache::Sync(const FloorMap& map, const GeodesicParams& params) {
   params_ = params;
   geometry_ = map.geometry();
   traversable_ = TraversableCells(map, params);
+  moves_ = MoveMasks(traversable_, params.connectivity);
 }
 
 GeodesicCache::Snapped GeodesicCache::Snap(const Eigen::Vector2f& p_W) const {
@@ -310,11 +393,11 @@ std::shared_ptr<const DistanceField> GeodesicCache::Field(const FloorMap& map,
   const Snapped s = Snap(source_W);
   if (!s.cell)
     return std::make_shared<const DistanceField>(
-        GeodesicField(traversable_, geometry_, {-1, -1}, params.connectivity));
+        FieldOverMoves(moves_, traversable_, geometry_, {-1, -1}, params.connectivity));
   auto& slot = fields_[Key(*s.cell)];
   if (!slot) {
     slot = std::make_shared<const DistanceField>(
-        GeodesicField(traversable_, geometry_, *s.cell, params.connectivity));
+        FieldOverMoves(moves_, traversable_, geometry_, *s.cell, params.connectivity));
     ++fields_computed_;
   }
   return slot;
@@ -331,17 +414,13 @@ Result<std::vector<Eigen::Vector2f>> GeodesicCache::Path(const FloorMap& map,
   return ExtractPath(*field, geometry_.CellCenter(target.cell->x(), target.cell->y()));
 }
 
-Eigen::MatrixXf GeodesicCache::DistanceMatrix(const FloorMap& map,
-                                              std::span<const Eigen::Vector2f> points_W,
-                                              const GeodesicParams& params) {
+void GeodesicCache::Prefetch(const FloorMap& map, std::span<const Eigen::Vector2f> sources_W,
+                             const GeodesicParams& params) {
   Sync(map, params);
-  const size_t n = points_W.size();
-  std::vector<Snapped> snapped(n);
   std::vector<Eigen::Vector2i> missing;
-  for (size_t i = 0; i < n; ++i) {
-    snapped[i] = Snap(points_W[i]);
-    if (snapped[i].cell && !fields_.count(Key(*snapped[i].cell)))
-      missing.push_back(*snapped[i].cell);
+  for (const Eigen::Vector2f& p_W : sources_W) {
+    const Snapped s = Snap(p_W);
+    if (s.cell && !fields_.count(Key(*s.cell))) missing.push_back(*s.cell);
   }
   std::sort(missing.begin(), missing.end(),
             [](const Eigen::Vector2i& a, const Eigen::Vector2i& b) { return Key(a) < Key(b); });
@@ -351,10 +430,19 @@ Eigen::MatrixXf GeodesicCache::DistanceMatrix(const FloorMap& map,
   ParallelFor(missing.size(), 1, [&](size_t begin, size_t end) {
     for (size_t k = begin; k < end; ++k)
       computed[k] = std::make_shared<const DistanceField>(
-          GeodesicField(traversable_, geometry_, missing[k], params.connectivity));
+          FieldOverMoves(moves_, traversable_, geometry_, missing[k], params.connectivity));
   });
   for (size_t k = 0; k < missing.size(); ++k) fields_[Key(missing[k])] = computed[k];
   fields_computed_ += missing.size();
+}
+
+Eigen::MatrixXf GeodesicCache::DistanceMatrix(const FloorMap& map,
+                                              std::span<const Eigen::Vector2f> points_W,
+                                              const GeodesicParams& params) {
+  Prefetch(map, points_W, params);
+  const size_t n = points_W.size();
+  std::vector<Snapped> snapped(n);
+  for (size_t i = 0; i < n; ++i) snapped[i] = Snap(points_W[i]);
 
   Eigen::MatrixXf distances = Eigen::MatrixXf::Constant(Eigen::Index(n), Eigen::Index(n), kInf);
   for (size_t i = 0; i < n; ++i) {

@@ -80,6 +80,9 @@ class GeodesicCache {
   // field leaves out its offset. Shared, so it outlives an invalidation.
   std::shared_ptr<const DistanceField> Field(const FloorMap& map, const Eigen::Vector2f& source_W,
                                              const GeodesicParams& params);
+  // Computes the fields of the sources not cached yet, in parallel (one per source cell).
+  void Prefetch(const FloorMap& map, std::span<const Eigen::Vector2f> sources_W,
+                const GeodesicParams& params);
   // n x n matrix, row i = distances from points_W[i]; the diagonal is 0. Fields of sources not
   // yet cached are computed in parallel, one per source cell.
   Eigen::MatrixXf DistanceMatrix(const FloorMap& map, std::span<const Eigen::Vector2f> points_W,
@@ -111,6 +114,7 @@ class GeodesicCache {
   GeodesicParams params_;
   FloorGeometry geometry_;
   Image<uint8_t> traversable_;
+  std::vector<uint32_t> moves_;  // per cell, the moves that stay on traversable cells
   std::map<uint64_t, std::shared_ptr<const DistanceField>> fields_;
   size_t fields_computed_ = 0;
 };

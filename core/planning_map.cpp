@@ -530,32 +530,40 @@ Eigen::Vector3f PlanningMap::NormalIn(const Neighbourhood& n, VoxelIndex v) cons
 }
 
 std::vector<MapSurfaceVoxel> PlanningMap::SurfaceVoxels() const {
-  // Entries of blocks still holding surface voxels carry over; stale ones are recomputed.
-  std::unordered_map<uint64_t, SurfaceCacheEntry> next;
-  next.reserve(blocks_.size());
-  std::vector<std::pair<uint64_t, SurfaceCacheEntry*>> stale;
-  size_t total = 0;
-  for (const auto& [key, pb] : blocks_) {
-    if (Popcount(pb.surface) == 0) continue;
-    SurfaceCacheEntry& entry = next[key];
-    const auto cached = surface_cache_.find(key);
-    if (cached != surface_cache_.end() && cached->second.revision == pb.revision) {
-      entry = std::move(cached->second);
-      total += entry.voxels.size();
+  // Blocks holding surface voxels, in key order: the output's order.
+  std::vector<std::pair<uint64_t, const PlanningBlock*>> blocks;
+  for (const auto& [key, pb] : blocks_)
+    if (Popcount(pb.surface) > 0) blocks.emplace_back(key, &pb);
+  std::sort(blocks.begin(), blocks.end(),
+            [](const auto& a, const auto& b) { return a.first < b.first; });
+  // Entries of blocks still holding surface voxels carry over (a merge of two key-sorted lists);
+  // stale ones are recomputed.
+  std::vector<SurfaceCacheEntry> next(blocks.size());
+  std::vector<size_t> stale;
+  size_t c = 0;
+  for (size_t k = 0; k < blocks.size(); ++k) {
+    const auto& [key, pb] = blocks[k];
+    while (c < surface_cache_.size() && surface_cache_[c].key < key) ++c;
+    if (c < surface_cache_.size() && surface_cache_[c].key == key &&
+        surface_cache_[c].revision == pb->revision) {
+      next[k] = std::move(surface_cache_[c]);
     } else {
-      entry.revision = pb.revision;
-      stale.emplace_back(key, &entry);
+      next[k].key = key;
+      next[k].revision = pb->revision;
+      stale.push_back(k);
     }
   }
   const float s = volume_->voxel_size_m();
   ParallelFor(stale.size(), 8, [&](size_t begin, size_t end) {
     for (size_t j = begin; j < end; ++j) {
-      const BlockIndex b = UnpackBlockIndex(stale[j].first);
+      const auto& [key, pb] = blocks[stale[j]];
+      const BlockIndex b = UnpackBlockIndex(key);
       const Neighbourhood n = NeighbourhoodOf(b);
       const TsdfBlock* tb = n.self;
       if (!tb) continue;
-      std::vector<MapSurfaceVoxel>& voxels = stale[j].second->voxels;
-      ForEachBit(blocks_.at(stale[j].first).surface, [&](int i) {
+      std::vector<MapSurfaceVoxel>& voxels = next[stale[j]].voxels;
+      voxels.reserve(size_t(Popcount(pb->surface)));
+      ForEachBit(pb->surface, [&](int i) {
         MapSurfaceVoxel v;
         v.index = GlobalOf(b, VoxelOfLinear(i));
         v.center_W = VoxelCenter(v.index, s);
@@ -566,24 +574,24 @@ std::vector<MapSurfaceVoxel> PlanningMap::SurfaceVoxels() const {
       });
     }
   });
-  for (const auto& [key, entry] : stale) total += entry->voxels.size();
   surface_cache_ = std::move(next);
-  std::vector<uint64_t> keys;
-  keys.reserve(surface_cache_.size());
-  for (const auto& [key, entry] : surface_cache_) keys.push_back(key);
-  std::sort(keys.begin(), keys.end());
-  std::vector<MapSurfaceVoxel> out;
-  out.reserve(total);
-  for (uint64_t key : keys) {
-    const std::vector<MapSurfaceVoxel>& voxels = surface_cache_.at(key).voxels;
-    const size_t first = out.size();
-    out.insert(out.end(), voxels.begin(), voxels.end());
-    // Labels change without a block update (FuseLabels), so they are read here, not cached.
-    const auto lb = labels_.find(key);
-    if (lb == labels_.end()) continue;
-    for (size_t i = first; i < out.size(); ++i)
-      out[i].label = FusedLabel(*lb->second, LinearIndex(LocalOf(out[i].index)));
-  }
+  // Each block into its own range of the output, in parallel.
+  std::vector<size_t> first(surface_cache_.size() + 1, 0);
+  for (size_t k = 0; k < surface_cache_.size(); ++k)
+    first[k + 1] = first[k] + surface_cache_[k].voxels.size();
+  std::vector<MapSurfaceVoxel> out(first.back());
+  ParallelFor(surface_cache_.size(), 64, [&](size_t begin, size_t end) {
+    for (size_t k = begin; k < end; ++k) {
+      const std::vector<MapSurfaceVoxel>& voxels = surface_cache_[k].voxels;
+      MapSurfaceVoxel* dst = out.data() + first[k];
+      std::copy(voxels.begin(), voxels.end(), dst);
+      // Labels change without a block update (FuseLabels), so they are read here, not cached.
+      const auto lb = labels_.find(surface_cache_[k].key);
+      if (lb == labels_.end()) continue;
+      for (size_t i = 0; i < voxels.size(); ++i)
+        dst[i].label = FusedLabel(*lb->second, LinearIndex(LocalOf(dst[i].index)));
+    }
+  });
   return out;
 }
 

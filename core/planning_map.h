@@ -169,12 +169,13 @@ class PlanningMap {
   std::unordered_map<uint32_t, std::string> classes_;
   // SurfaceVoxels per block, valid while the block's revision is unchanged: a block's surface
   // voxels and their normals depend on its TSDF and its face neighbours', and UpdateBlocks
-  // stamps a block whenever it or a face neighbour was touched.
+  // stamps a block whenever it or a face neighbour was touched. Sorted by key.
   struct SurfaceCacheEntry {
+    uint64_t key = 0;  // PackBlockIndex
     uint64_t revision = 0;
     std::vector<MapSurfaceVoxel> voxels;
   };
-  mutable std::unordered_map<uint64_t, SurfaceCacheEntry> surface_cache_;
+  mutable std::vector<SurfaceCacheEntry> surface_cache_;
 };
 
 }  // namespace voxplan

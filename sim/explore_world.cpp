@@ -4,6 +4,8 @@
 #include <cmath>
 #include <limits>
 
+#include "core/parallel.h"
+
 namespace voxplan {
 
 namespace {
@@ -140,17 +142,18 @@ std::vector<Eigen::Vector3f> ExploreWorld::FrontierVoxels() const {
 
 std::vector<SurfaceVoxel> ExploreWorld::SurfaceVoxels() const {
   const std::vector<MapSurfaceVoxel> voxels = map_->SurfaceVoxels();
-  std::vector<SurfaceVoxel> out;
-  out.reserve(voxels.size());
-  for (const MapSurfaceVoxel& v : voxels) {
-    SurfaceVoxel s;
-    s.position = v.center_W;
-    s.normal = v.normal_W;
-    s.uncertainty = std::clamp(v.uncertainty, 0.f, 1.f);
-    s.weight = v.weight;
-    s.instance = v.label == 0 ? -1 : int32_t(v.label);
-    out.push_back(s);
-  }
+  std::vector<SurfaceVoxel> out(voxels.size());
+  ParallelFor(voxels.size(), 4096, [&](size_t begin, size_t end) {
+    for (size_t i = begin; i < end; ++i) {
+      const MapSurfaceVoxel& v = voxels[i];
+      SurfaceVoxel& s = out[i];
+      s.position = v.center_W;
+      s.normal = v.normal_W;
+      s.uncertainty = std::clamp(v.uncertainty, 0.f, 1.f);
+      s.weight = v.weight;
+      s.instance = v.label == 0 ? -1 : int32_t(v.label);
+    }
+  });
   return out;
 }
 
@@ -183,16 +186,22 @@ GeodesicCache& ExploreWorld::CacheFor(float min_clearance_m) const {
 Result<std::vector<float>> ExploreWorld::GeodesicField(const Eigen::Vector2f& source_m,
                                                        float min_clearance_m) const {
   if (floor_map_->width() <= 0) return Unsupported("the floor map is still empty");
+  GeodesicCache& cache = CacheFor(min_clearance_m);
+  // A planner reads the fields of all robots in turn: asked for one, compute every robot's at
+  // once, in parallel (the cache keeps them for the calls that follow).
+  std::vector<Eigen::Vector2f> robots_m;
+  for (const PlannerRobot& r : robots_) robots_m.push_back(r.position_m);
+  if (std::find(robots_m.begin(), robots_m.end(), source_m) != robots_m.end())
+    cache.Prefetch(*floor_map_, robots_m, Geodesic(min_clearance_m));
   const std::shared_ptr<const DistanceField> field =
-      CacheFor(min_clearance_m).Field(*floor_map_, source_m, Geodesic(min_clearance_m));
+      cache.Field(*floor_map_, source_m, Geodesic(min_clearance_m));
   // Into the planner's padded raster (the margin is unknown: unreachable).
   const FloorGeometry& g = floor_map_->geometry();
   if (field->geometry != g || floor_.width != g.width + 2 * pad_)
     return Status(StatusCode::kInternal, "explore world: Refresh() missed a floor map change");
   std::vector<float> out(floor_.cells.size(), kInf);
   for (int y = 0; y < g.height; ++y)
-    for (int x = 0; x < g.width; ++x)
-      out[floor_.Linear(x + pad_, y + pad_)] = field->distance_m.at(x, y);
+    std::copy_n(&field->distance_m.at(0, y), g.width, &out[floor_.Linear(pad_, y + pad_)]);
   return out;
 }
 

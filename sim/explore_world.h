@@ -3,7 +3,8 @@
 // free-space carving), its floor map with clearance, and the simulated robots. Geodesic queries
 // go through GeodesicCache (one per clearance asked for), so fields computed for the host's
 // validation and the robots' own routing are shared with the plugin's queries of the same
-// floor-map revision.
+// floor-map revision; the first field asked for from a robot's position brings every robot's,
+// computed in parallel.
 #include <map>
 #include <set>
 #include <span>

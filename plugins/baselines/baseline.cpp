@@ -21,7 +21,7 @@ BaselineWorld ReadBaselineWorld(const vp::WorldView& world, const CommonOptions&
   for (const omt::TaskView& v : b.views) {
     b.important.push_back(v.importance > options.omt.importance_threshold ? 1 : 0);
   }
-  for (const std::vector<float>& field : b.input.robot_fields) {
+  for (const std::span<const float> field : b.input.robot_fields) {
     b.robot_view_m.emplace_back();
     for (const omt::TaskView& v : b.views) {
       b.robot_view_m.back().push_back(v.cell >= 0 && size_t(v.cell) < field.size()

@@ -1,6 +1,7 @@
 #include "plugins/baselines/world_input.h"
 
 #include <algorithm>
+#include <cassert>
 #include <chrono>
 #include <cmath>
 #include <limits>
@@ -205,16 +206,16 @@ void ReadHostReach(const vp::WorldView& world, WorldInput* input) {
   for (const vp_robot& robot : input->robots) {
     const std::span<const float> field =
         world.GeodesicField(robot.x_m, robot.y_m, input->min_clearance_m);
-    std::vector<float> copy(field.begin(), field.end());
-    copy.resize(n, std::numeric_limits<float>::infinity());
+    // The floor's size, as the raster's (ReadWorld read the same floor).
+    assert(field.size() == n);
     bool any = false;
     for (size_t i = 0; i < n; ++i) {
-      if (!std::isfinite(copy[i])) continue;
+      if (!std::isfinite(field[i])) continue;
       input->accessible[i] = 1;
       any = true;
     }
     input->anchored_robots += any;
-    input->robot_fields.push_back(std::move(copy));
+    input->robot_fields.push_back(field);
   }
 }
 
@@ -253,8 +254,8 @@ void SettledCells::Update(const vp::WorldView& world, const WorldInput& input,
       omt::TraverseRay(g, p, dir, sensor.d_max_m, [&](int cell, double) {
         if (cell == start) return true;
         const omt::Cell c = raster.At(cell);
-        const double d = (g.Center(cell) - p).norm();
         if (c == omt::Cell::kFree) return true;
+        const double d = (g.Center(cell) - p).norm();
         const bool in_range = d >= sensor.d_min_m && d <= sensor.d_max_m;
         if (c == omt::Cell::kOccupied) {
           const double u = omt::CellUncertainty(c, raster.WeightAt(cell), uncertainty);

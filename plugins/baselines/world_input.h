@@ -8,6 +8,7 @@
 #include <map>
 #include <nlohmann/json.hpp>
 #include <set>
+#include <span>
 #include <string>
 #include <vector>
 
@@ -69,9 +70,10 @@ struct WorldInput {
   float min_clearance_m = 0.f;     // for host geodesic queries: robot_radius_m + margin
   double surface_voxels_ms = 0.0;  // spent in the host's surface voxel query
   double fov_rad = 0.0;            // narrowest horizontal FOV of the robots' modes; 0: unknown
-  // ReadHostReach: per robot the host's geodesic field (min_clearance_m), the cells any of them
-  // reaches, and how many robots reach any cell (a robot the host cannot place reaches none).
-  std::vector<std::vector<float>> robot_fields;
+  // ReadHostReach: per robot the host's geodesic field (min_clearance_m; host memory, valid
+  // during the plan call), the cells any of them reaches, and how many robots reach any cell (a
+  // robot the host cannot place reaches none).
+  std::vector<std::span<const float>> robot_fields;
   std::vector<uint8_t> accessible;
   int anchored_robots = 0;
 };

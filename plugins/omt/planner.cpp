@@ -231,7 +231,11 @@ Status PlanOmt(const OccupancyRaster& raster, const ClearanceRaster* clearance_i
   SmoothingParams smoothing = options.smoothing;
   smoothing.min_clearance_m = options.robot_radius_m;
   std::vector<Status> statuses(static_cast<std::size_t>(R));
-  // Provider callbacks (the host's) are only ever called from this thread.
+  // First each robot's polyline through its tasks, then the smoothing. Provider callbacks (the
+  // host's) are only ever called from this thread, so with them the polylines are built one
+  // robot after the other; the smoothing, each robot's own, always runs in parallel.
+  std::vector<std::vector<Eigen::Vector2d>> polylines(static_cast<std::size_t>(R));
+  std::vector<std::vector<std::pair<int, int>>> task_vertices(static_cast<std::size_t>(R));
   const int robot_threads = external_paths ? 1 : options.num_threads;
   ParallelFor(R, robot_threads, [&](int r) {
     RobotPlan& plan = result->robots[static_cast<std::size_t>(r)];
@@ -250,8 +254,7 @@ Status PlanOmt(const OccupancyRaster& raster, const ClearanceRaster* clearance_i
     const std::vector<int> order = options.use_tsp
                                        ? OpenPathChristofides(local, 0, end, options.tsp)
                                        : OpenPathGreedy(local, 0);
-    std::vector<Eigen::Vector2d> polyline;
-    std::vector<std::pair<int, int>> task_vertices;
+    std::vector<Eigen::Vector2d>& polyline = polylines[static_cast<std::size_t>(r)];
     int from = nodes[static_cast<std::size_t>(order[0])];
     for (std::size_t i = 1; i < order.size(); ++i) {
       const int to = nodes[static_cast<std::size_t>(order[i])];
@@ -266,12 +269,18 @@ Status PlanOmt(const OccupancyRaster& raster, const ClearanceRaster* clearance_i
       if (leg.empty()) continue;  // not reachable from here: the task is skipped
       for (std::size_t v = polyline.empty() ? 0 : 1; v < leg.size(); ++v)
         polyline.push_back(leg[v]);
-      task_vertices.emplace_back(static_cast<int>(polyline.size()) - 1, to - R);
+      task_vertices[static_cast<std::size_t>(r)].emplace_back(static_cast<int>(polyline.size()) - 1,
+                                                              to - R);
       plan.tasks.push_back(to - R);
       from = to;
     }
+  });
+  ParallelFor(R, options.num_threads, [&](int r) {
+    const std::vector<Eigen::Vector2d>& polyline = polylines[static_cast<std::size_t>(r)];
     if (polyline.empty()) return;
-    plan.path = SamplePolyline(polyline, task_vertices, smoothing.sample_spacing_m);
+    RobotPlan& plan = result->robots[static_cast<std::size_t>(r)];
+    plan.path = SamplePolyline(polyline, task_vertices[static_cast<std::size_t>(r)],
+                               smoothing.sample_spacing_m);
     const RobotState& robot = robots[static_cast<std::size_t>(r)];
     if (options.optimize_paths) {
       statuses[static_cast<std::size_t>(r)] = SmoothPath(clearance, smoothing, &plan.path);

@@ -75,13 +75,13 @@ double ViewImportance(const OccupancyRaster& raster, const Eigen::Vector2d& p_m,
     TraverseRay(g, p_m, dir, s.d_max_m, [&](int cell, double t) {
       if (cell == start) return true;
       const Cell c = raster.At(cell);
-      const double d = (g.Center(cell) - p_m).norm();
       if (c == Cell::kFree) {
         // Unknown space ended in free space we already know: the ray stays transparent.
         unknown_since = -1.0;
         contribute(cell, 0.0);
         return true;
       }
+      const double d = (g.Center(cell) - p_m).norm();  // free cells, the most, need none
       if (c == Cell::kOccupied) {
         const auto normal = SurfaceNormal(raster, cell, s);
         double phi = 1.0;

@@ -4,7 +4,12 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <functional>
+#include <limits>
 #include <memory>
+#include <queue>
+#include <utility>
+#include <vector>
 
 #include "fusion/integrate_planning.h"
 #include "fusion/mesh_extract.h"
@@ -176,8 +181,68 @@ TEST(Explore, StartsAreFreeSideBySideAndBadOnesAreRefused) {
   EXPECT_FALSE(run.ok());
 }
 
+// One frame of the small apartment from the first start, fused into `map` and `floor`.
+void FuseFirstFrame(const Eigen::Vector2f& start, TsdfVolume& volume, PlanningMap& map,
+                    FloorMap& floor) {
+  RobotState state;
+  state.position_W = start;
+  const Pose3f T_W_C = CameraPoseFromState(state, FastParams().robot.camera_height_m);
+  const PinholeCamera camera = CameraWithFov(160, 120, 90.f);
+  std::unique_ptr<MeshRaycaster> raycaster = MeshRaycaster::Create(SmallApartment().world).value();
+  const RenderOutput frame = raycaster->Render(camera, T_W_C, {.max_range_m = 5.f});
+  Result<PlanningFrameStats> stats =
+      IntegratePlanningFrame(frame.depth, frame.color, nullptr, camera, T_W_C, {}, volume, map);
+  ASSERT_TRUE(stats.ok()) << stats.status().message();
+  ASSERT_TRUE(floor.Update(volume, stats->integrate.touched_blocks).ok());
+  ASSERT_GT(floor.width(), 0);
+}
+
+// A plain heap Dijkstra over the 16 moves of core/geodesic.h (the cells a move crosses must be
+// traversable too), summing float move costs in cells and scaling at the end as GeodesicField
+// does: the same arithmetic, so its distances are the exact ones to expect.
+std::vector<float> ReferenceField(const PlannerFloor& f, float min_clearance_m,
+                                  Eigen::Vector2i source) {
+  struct Move {
+    int dx, dy;
+    float cost;
+    Eigen::Vector2i via0, via1;
+  };
+  std::vector<Move> moves;
+  for (int s = -1; s <= 1; s += 2) {
+    moves.push_back({s, 0, 1.f, {s, 0}, {s, 0}});
+    moves.push_back({0, s, 1.f, {0, s}, {0, s}});
+    for (int t = -1; t <= 1; t += 2) {
+      moves.push_back({s, t, std::sqrt(2.f), {s, 0}, {0, t}});
+      moves.push_back({2 * s, t, std::sqrt(5.f), {s, 0}, {s, t}});
+      moves.push_back({s, 2 * t, std::sqrt(5.f), {0, t}, {s, t}});
+    }
+  }
+  const auto open = [&](Eigen::Vector2i c) { return f.Traversable(c.x(), c.y(), min_clearance_m); };
+  std::vector<float> dist(f.cells.size(), std::numeric_limits<float>::infinity());
+  using Entry = std::pair<float, size_t>;
+  std::priority_queue<Entry, std::vector<Entry>, std::greater<>> heap;
+  dist[f.Linear(source.x(), source.y())] = 0.f;
+  heap.push({0.f, f.Linear(source.x(), source.y())});
+  while (!heap.empty()) {
+    const auto [d, i] = heap.top();
+    heap.pop();
+    if (d > dist[i]) continue;
+    const Eigen::Vector2i c(int(i % size_t(f.width)), int(i / size_t(f.width)));
+    for (const Move& m : moves) {
+      const Eigen::Vector2i to = c + Eigen::Vector2i(m.dx, m.dy);
+      if (!open(to) || !open(c + m.via0) || !open(c + m.via1)) continue;
+      const size_t j = f.Linear(to.x(), to.y());
+      if (d + m.cost < dist[j]) {
+        dist[j] = d + m.cost;
+        heap.push({dist[j], j});
+      }
+    }
+  }
+  for (float& d : dist) d *= f.cell_size_m;
+  return dist;
+}
+
 TEST(ExploreWorld, PadsTheFloorWithUnknownAndFreesCellsUnderRobots) {
-  // One frame of the small apartment from the first start, fused into a planning map.
   const Scene& s = SmallApartment();
   const ExploreParams params = FastParams();
   const Eigen::Vector2f start =
@@ -185,17 +250,7 @@ TEST(ExploreWorld, PadsTheFloorWithUnknownAndFreesCellsUnderRobots) {
   TsdfVolume volume(VolumeParams{0.05f, 0.15f});
   PlanningMap map(volume);
   FloorMap floor(0.05f, params.floor);
-  RobotState state;
-  state.position_W = start;
-  const Pose3f T_W_C = CameraPoseFromState(state, params.robot.camera_height_m);
-  const PinholeCamera camera = CameraWithFov(160, 120, 90.f);
-  std::unique_ptr<MeshRaycaster> raycaster = MeshRaycaster::Create(s.world).value();
-  const RenderOutput frame = raycaster->Render(camera, T_W_C, {.max_range_m = 5.f});
-  Result<PlanningFrameStats> stats =
-      IntegratePlanningFrame(frame.depth, frame.color, nullptr, camera, T_W_C, {}, volume, map);
-  ASSERT_TRUE(stats.ok()) << stats.status().message();
-  ASSERT_TRUE(floor.Update(volume, stats->integrate.touched_blocks).ok());
-  ASSERT_GT(floor.width(), 0);
+  FuseFirstFrame(start, volume, map, floor);
 
   ExploreWorldParams wp;
   wp.unknown_margin_m = 1.0f;
@@ -241,6 +296,50 @@ TEST(ExploreWorld, PadsTheFloorWithUnknownAndFreesCellsUnderRobots) {
   size_t reachable = 0;
   for (float d : *field) reachable += std::isfinite(d) ? 1 : 0;
   EXPECT_GT(reachable, 50u);
+}
+
+TEST(ExploreWorld, GeodesicFieldsOfRobotsAreExactDijkstraDistances) {
+  const Scene& s = SmallApartment();
+  const ExploreParams params = FastParams();
+  const Eigen::Vector2f start =
+      ChooseStarts(s.plan, s.world.rooms, 1, params.robot.radius_m).value()[0];
+  TsdfVolume volume(VolumeParams{0.05f, 0.15f});
+  PlanningMap map(volume);
+  FloorMap floor(0.05f, params.floor);
+  FuseFirstFrame(start, volume, map, floor);
+  ExploreWorld world(map, floor, {});
+  world.Refresh();
+  const PlannerFloor& f = world.Floor();
+
+  // Robots on the first and the last traversable cell: the first asked for computes both fields
+  // at once, in parallel; each must still be its own robot's.
+  const float radius = params.robot.radius_m;
+  std::vector<size_t> traversable;
+  for (size_t i = 0; i < f.cells.size(); ++i)
+    if (f.Traversable(int(i % size_t(f.width)), int(i / size_t(f.width)), radius))
+      traversable.push_back(i);
+  ASSERT_GT(traversable.size(), 100u);
+  std::vector<PlannerRobot> robots(2);
+  const size_t cells[2] = {traversable.front(), traversable.back()};
+  for (size_t r = 0; r < 2; ++r)
+    robots[r].position_m =
+        f.CellCenter(int(cells[r] % size_t(f.width)), int(cells[r] / size_t(f.width)));
+  world.SetRobots(robots);
+  for (size_t r = 0; r < 2; ++r) {
+    Result<std::vector<float>> field = world.GeodesicField(robots[r].position_m, radius);
+    ASSERT_TRUE(field.ok()) << field.status().message();
+    const Eigen::Vector2i source = f.CellOf(robots[r].position_m);
+    const std::vector<float> expected = ReferenceField(f, radius, source);
+    ASSERT_EQ(field->size(), expected.size());
+    size_t reachable = 0, mismatches = 0;
+    for (size_t i = 0; i < expected.size(); ++i) {
+      reachable += std::isfinite(expected[i]) ? 1 : 0;
+      // Bit-exact: the same float sums in any order of settling.
+      mismatches += (*field)[i] == expected[i] ? 0 : 1;
+    }
+    EXPECT_GT(reachable, 50u) << "robot " << r;
+    EXPECT_EQ(mismatches, 0u) << "robot " << r;
+  }
 }
 
 }  // namespace
