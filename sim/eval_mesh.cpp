@@ -148,6 +148,16 @@ double Median(std::vector<double> values) {
 
 }  // namespace
 
+PointSetFilter KeepEach(std::function<bool(const Eigen::Vector3f&)> keep) {
+  return [keep = std::move(keep)](const std::vector<Eigen::Vector3f>& points) {
+    std::vector<uint8_t> kept(points.size(), 0);
+    ParallelFor(points.size(), kQueryGrain, [&](size_t begin, size_t end) {
+      for (size_t i = begin; i < end; ++i) kept[i] = keep(points[i]) ? 1 : 0;
+    });
+    return kept;
+  };
+}
+
 Result<MeshEvalResult> EvaluateMesh(const Mesh& reconstruction, const Mesh& ground_truth,
                                     const MeshEvalParams& params) {
   if (!(params.samples_per_m2 > 0.f) || !std::isfinite(params.samples_per_m2))
@@ -191,15 +201,16 @@ Result<MeshEvalResult> EvaluateMesh(const Mesh& reconstruction, const Mesh& grou
   // threshold_m, over all of them and over those the filter keeps (the observable surface).
   std::vector<uint8_t> kept(truth_samples.size(), 1);
   if (params.ground_truth_filter) {
-    ParallelFor(truth_samples.size(), kQueryGrain, [&](size_t begin, size_t end) {
-      for (size_t i = begin; i < end; ++i) {
-        const Point& p = truth_samples[i];
-        kept[i] =
-            params.ground_truth_filter(Eigen::Vector3f(float(p.x()), float(p.y()), float(p.z())))
-                ? 1
-                : 0;
-      }
-    });
+    std::vector<Eigen::Vector3f> points;
+    points.reserve(truth_samples.size());
+    for (const Point& p : truth_samples)
+      points.emplace_back(float(p.x()), float(p.y()), float(p.z()));
+    kept = params.ground_truth_filter(points);
+    if (kept.size() != points.size())
+      return InvalidArgument("EvaluateMesh: ground_truth_filter answered for " +
+                             std::to_string(kept.size()) + " of " + std::to_string(points.size()) +
+                             " samples");
+    for (uint8_t& k : kept) k = k ? 1 : 0;
   }
   const size_t kept_count = size_t(std::count(kept.begin(), kept.end(), uint8_t(1)));
   if (kept_count == 0)

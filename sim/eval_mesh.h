@@ -16,13 +16,20 @@
 
 namespace voxplan {
 
+// Which of a set of world-frame points to keep: one flag (0 or 1) per point, in order. A whole
+// set at once, so that a filter can stream through what it needs (sim/visibility.h renders one
+// view at a time).
+using PointSetFilter =
+    std::function<std::vector<uint8_t>(const std::vector<Eigen::Vector3f>& points)>;
+// A PointSetFilter asking `keep` point by point, from several threads at once.
+PointSetFilter KeepEach(std::function<bool(const Eigen::Vector3f&)> keep);
+
 struct MeshEvalParams {
   float threshold_m = 0.05f;
   float samples_per_m2 = 10000.0f;
   uint64_t seed = 1;
-  // Which ground-truth samples (world frame) count for `completeness`; empty: all of them.
-  // Called from several threads at once, so it must be safe to call concurrently.
-  std::function<bool(const Eigen::Vector3f&)> ground_truth_filter;
+  // Which ground-truth samples count for `completeness`; empty: all of them.
+  PointSetFilter ground_truth_filter;
 };
 
 struct MeshEvalResult {
@@ -38,7 +45,8 @@ struct MeshEvalResult {
   size_t ground_truth_samples_all = 0;  // before the filter
 };
 
-// Refuses empty meshes, and a filter that keeps no ground-truth sample.
+// Refuses empty meshes, and a filter that keeps no ground-truth sample (or answers for another
+// number of samples).
 Result<MeshEvalResult> EvaluateMesh(const Mesh& reconstruction, const Mesh& ground_truth,
                                     const MeshEvalParams& params = {});
 

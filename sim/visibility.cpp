@@ -7,20 +7,18 @@
 #include <string>
 
 #include "core/image.h"
+#include "core/parallel.h"
 
 namespace voxplan {
 
 namespace {
 
+constexpr size_t kPointGrain = 4096;
+constexpr size_t kViewsPerPass = 32;
+
 struct View {
   Pose3f T_C_W;
   DepthImage depth;
-};
-
-struct Views {
-  PinholeCamera camera;
-  VisibilityParams params;
-  std::vector<View> views;
 };
 
 bool SeenIn(const View& view, const PinholeCamera& camera, const VisibilityParams& params,
@@ -48,10 +46,10 @@ bool SeenIn(const View& view, const PinholeCamera& camera, const VisibilityParam
 
 }  // namespace
 
-Result<PointFilter> ObservableSurfaceFilter(const MeshRaycaster& raycaster,
-                                            const PinholeCamera& camera,
-                                            const std::vector<Pose3d>& T_W_C,
-                                            const VisibilityParams& params) {
+Result<PointSetFilter> ObservableSurfaceFilter(const MeshRaycaster& raycaster,
+                                               const PinholeCamera& camera,
+                                               const std::vector<Pose3d>& T_W_C,
+                                               const VisibilityParams& params) {
   if (!camera.Valid()) return InvalidArgument("ObservableSurfaceFilter: invalid camera");
   if (T_W_C.empty()) return InvalidArgument("ObservableSurfaceFilter: no poses");
   if (params.pose_stride < 1)
@@ -61,25 +59,38 @@ Result<PointFilter> ObservableSurfaceFilter(const MeshRaycaster& raycaster,
     return InvalidArgument("ObservableSurfaceFilter: need 0 <= min_depth_m < max_depth_m");
   if (!(params.depth_tolerance_m > 0.f) || !std::isfinite(params.depth_tolerance_m))
     return InvalidArgument("ObservableSurfaceFilter: depth_tolerance_m must be positive");
-
-  auto views = std::make_shared<Views>();
-  views->camera = camera;
-  views->params = params;
-  // Render to the full range: a nearer hit beyond max_depth_m still hides what is behind it.
-  const RenderParams render_params;
+  std::vector<Pose3f> poses;
   for (size_t k = 0; k < T_W_C.size(); k += size_t(params.pose_stride)) {
     if (!T_W_C[k].matrix().allFinite())
       return InvalidArgument("ObservableSurfaceFilter: pose " + std::to_string(k) +
                              " is not finite");
-    const Pose3f T_W_Ck = T_W_C[k].cast<float>();
-    views->views.push_back(
-        {T_W_Ck.inverse(), raycaster.Render(camera, T_W_Ck, render_params).depth});
+    poses.push_back(T_W_C[k].cast<float>());
   }
-  std::shared_ptr<const Views> shared = std::move(views);
-  return PointFilter([shared](const Eigen::Vector3f& p_W) {
-    for (const View& view : shared->views)
-      if (SeenIn(view, shared->camera, shared->params, p_W)) return true;
-    return false;
+  return PointSetFilter([&raycaster, camera, params,
+                         poses = std::move(poses)](const std::vector<Eigen::Vector3f>& points) {
+    std::vector<uint8_t> kept(points.size(), 0);
+    // Render to the full range: a nearer hit beyond max_depth_m still hides what is behind it.
+    const RenderParams render_params;
+    // Views a batch at a time: memory for kViewsPerPass depth images, and one sweep over the
+    // points per batch rather than per view.
+    std::vector<View> views;
+    for (size_t first = 0; first < poses.size(); first += kViewsPerPass) {
+      views.clear();
+      for (size_t k = first; k < std::min(first + kViewsPerPass, poses.size()); ++k)
+        views.push_back(
+            {poses[k].inverse(), raycaster.Render(camera, poses[k], render_params).depth});
+      ParallelFor(points.size(), kPointGrain, [&](size_t begin, size_t end) {
+        for (size_t i = begin; i < end; ++i) {
+          if (kept[i]) continue;
+          for (const View& view : views)
+            if (SeenIn(view, camera, params, points[i])) {
+              kept[i] = 1;
+              break;
+            }
+        }
+      });
+    }
+    return kept;
   });
 }
 

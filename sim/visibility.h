@@ -3,12 +3,12 @@
 // MeshEvalParams::ground_truth_filter, so completeness is scored on the observable surface
 // (box bottoms, the floor under furniture, walls behind it and rooms never looked at drop out).
 #include <Eigen/Core>
-#include <functional>
 #include <vector>
 
 #include "core/camera.h"
 #include "core/pose.h"
 #include "core/status.h"
+#include "sim/eval_mesh.h"
 #include "sim/raycaster.h"
 
 namespace voxplan {
@@ -20,7 +20,7 @@ struct VisibilityParams {
   // How far a point may lie off the rendered ground-truth depth and still be the visible surface.
   float depth_tolerance_m = 0.015f;
   // Use every pose_stride-th pose: consecutive frames see nearly the same, and each kept pose
-  // holds one depth image in memory.
+  // costs a render per call of the filter.
   int pose_stride = 1;
 };
 
@@ -28,14 +28,14 @@ struct VisibilityParams {
 // the camera within [min_depth_m, max_depth_m], projects inside the image, and its depth lies
 // within depth_tolerance_m of the span of the ground-truth depths rendered at the 2x2 pixel
 // centres around its projection (a sub-pixel test, so surfaces seen at grazing angles are not
-// lost to depth steps between pixels, while points behind an occluder are). `raycaster` renders
-// the ground-truth mesh; the depth images are rendered here, once. The returned predicate owns
-// them, is copyable and safe to call from several threads. Refuses an invalid camera, no poses,
-// pose_stride < 1, and a bad depth range or tolerance.
-using PointFilter = std::function<bool(const Eigen::Vector3f&)>;
-Result<PointFilter> ObservableSurfaceFilter(const MeshRaycaster& raycaster,
-                                            const PinholeCamera& camera,
-                                            const std::vector<Pose3d>& T_W_C,
-                                            const VisibilityParams& params = {});
+// lost to depth steps between pixels, while points behind an occluder are). The filter renders
+// the ground truth with `raycaster` at the kept poses each time it is called, a few at a time,
+// so its memory does not grow with the trajectory; `raycaster` must outlive it. Refuses an
+// invalid camera, no poses, a non-finite kept pose, pose_stride < 1, and a bad depth range or
+// tolerance.
+Result<PointSetFilter> ObservableSurfaceFilter(const MeshRaycaster& raycaster,
+                                               const PinholeCamera& camera,
+                                               const std::vector<Pose3d>& T_W_C,
+                                               const VisibilityParams& params = {});
 
 }  // namespace voxplan

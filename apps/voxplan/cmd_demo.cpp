@@ -97,12 +97,13 @@ int RunDemo(const DemoOptions& o) {
   eval_params.seed = 1;
   const Stopwatch eval_clock;
   // Completeness counts the surface the trajectory could observe: the same camera, poses and
-  // depth range that produced the frames. Every other pose suffices; it halves the memory.
+  // depth range that produced the frames. Every other pose suffices; it halves the renders.
   VisibilityParams visibility;
   visibility.min_depth_m = params.min_depth_m;
   visibility.max_depth_m = params.max_depth_m;
   visibility.pose_stride = kVisibilityPoseStride;
-  Result<PointFilter> observable = ObservableSurfaceFilter(**raycaster, camera, poses, visibility);
+  Result<PointSetFilter> observable =
+      ObservableSurfaceFilter(**raycaster, camera, poses, visibility);
   if (!observable.ok()) return Fail("visibility: " + observable.status().message());
   eval_params.ground_truth_filter = *observable;
   Result<MeshEvalResult> eval = EvaluateMesh(mesh, room, eval_params);

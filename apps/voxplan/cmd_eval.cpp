@@ -124,15 +124,17 @@ int RunEvalMesh(const EvalMeshOptions& o) {
   params.samples_per_m2 = float(o.samples_per_m2);
   params.seed = o.seed;
   const Stopwatch clock;
+  std::unique_ptr<MeshRaycaster> raycaster;  // the filter renders with it: it lives as long
   if (views) {
     // The ground truth as the sensor saw it, within the depth range that was fused.
-    Result<std::unique_ptr<MeshRaycaster>> raycaster = MeshRaycaster::Create(*ground_truth);
-    if (!raycaster.ok()) return Fail(MessageNaming(raycaster.status(), o.ground_truth));
+    Result<std::unique_ptr<MeshRaycaster>> created = MeshRaycaster::Create(*ground_truth);
+    if (!created.ok()) return Fail(MessageNaming(created.status(), o.ground_truth));
+    raycaster = std::move(*created);
     VisibilityParams visibility;
     visibility.min_depth_m = float(o.min_depth_m);
     visibility.max_depth_m = float(o.max_depth_m);
-    Result<PointFilter> observable =
-        ObservableSurfaceFilter(**raycaster, views->camera, views->T_W_C, visibility);
+    Result<PointSetFilter> observable =
+        ObservableSurfaceFilter(*raycaster, views->camera, views->T_W_C, visibility);
     if (!observable.ok()) return Fail(MessageNaming(observable.status(), o.observable_from));
     params.ground_truth_filter = *observable;
   }

@@ -127,16 +127,16 @@ Status WriteLines(const std::vector<std::string>& lines, const std::string& path
 // The reference surface for completeness: ground-truth samples a camera could see from the
 // scene's reachable floor, judged from a sim tour (a viewpoint cover with 360° spins); empty
 // filter (every sample) when no tour can be planned.
-Result<PointFilter> TourFilter(const World& world, const FloorPlan& plan,
-                               const MeshRaycaster& raycaster, const ExploreParams& params,
-                               size_t* tour_frames) {
+Result<PointSetFilter> TourFilter(const World& world, const FloorPlan& plan,
+                                  const MeshRaycaster& raycaster, const ExploreParams& params,
+                                  size_t* tour_frames) {
   TourParams tp;
   tp.robot = params.robot;
   tp.view_range_m = params.robot.explorer.max_range_m;
   tp.frame_step_m = 0.5f;
   tp.frame_step_deg = 20.f;
   Result<Tour> tour = PlanTour(plan, world.rooms, tp);
-  if (!tour.ok() || tour->T_W_C.empty()) return PointFilter{};
+  if (!tour.ok() || tour->T_W_C.empty()) return PointSetFilter{};
   std::vector<Pose3d> poses;
   for (const Pose3f& T : tour->T_W_C) poses.push_back(T.cast<double>());
   *tour_frames = poses.size();
@@ -235,14 +235,18 @@ int RunExploreCommand(const ExploreOptions& o) {
   Result<std::unique_ptr<MeshRaycaster>> gt_raycaster = MeshRaycaster::Create(*world);
   if (!gt_raycaster.ok()) return Fail(MessageNaming(gt_raycaster.status(), o.scene));
   size_t tour_frames = 0;
-  Result<PointFilter> filter = TourFilter(*world, *plan, **gt_raycaster, params, &tour_frames);
+  Result<PointSetFilter> filter = TourFilter(*world, *plan, **gt_raycaster, params, &tour_frames);
   if (!filter.ok()) return Fail(MessageNaming(filter.status(), o.scene));
   Result<SurfaceSamples> gt_samples = SampleSurface(world->mesh, 100.0, o.seed);
   if (!gt_samples.ok()) return Fail(MessageNaming(gt_samples.status(), o.scene));
   std::vector<Eigen::Vector3f> probe_points;
-  for (const Eigen::Vector3d& p : gt_samples->points) {
-    const Eigen::Vector3f q = p.cast<float>();
-    if (!*filter || (*filter)(q)) probe_points.push_back(q);
+  for (const Eigen::Vector3d& p : gt_samples->points) probe_points.push_back(p.cast<float>());
+  if (*filter) {
+    const std::vector<uint8_t> observable = (*filter)(probe_points);
+    size_t kept = 0;
+    for (size_t i = 0; i < probe_points.size(); ++i)
+      if (observable[i]) probe_points[kept++] = probe_points[i];
+    probe_points.resize(kept);
   }
   const double setup_ms = clock.ElapsedMs();
 

@@ -208,7 +208,13 @@ TEST(DemoRoom, TrajectoryObservesEveryExposedFace) {
     return Kind::kExposed;
   };
   constexpr int kGrid = 40;
-  size_t exposed = 0, exposed_seen = 0, hidden = 0, hidden_seen = 0;
+  // The grid points of every face, inset from its edges, then one call of the filter.
+  struct Probe {
+    size_t face;
+    Kind kind;
+  };
+  std::vector<Eigen::Vector3f> points;
+  std::vector<Probe> probes;
   for (size_t face = 0; face < mesh.num_triangles() / 2; ++face) {
     // Faces are quads of two triangles {0, 1, 2}, {0, 2, 3} over four own vertices.
     const auto& tri = mesh.triangles[2 * face];
@@ -216,26 +222,34 @@ TEST(DemoRoom, TrajectoryObservesEveryExposedFace) {
     const Eigen::Vector3f e1 = mesh.positions[tri[1]] - o;
     const Eigen::Vector3f e2 = mesh.positions[mesh.triangles[2 * face + 1][2]] - o;
     const float s1 = kEdgeInset_m / e1.norm(), s2 = kEdgeInset_m / e2.norm();
-    size_t face_exposed = 0, face_seen = 0;
     for (int i = 0; i < kGrid; ++i)
       for (int j = 0; j < kGrid; ++j) {
         const float a = s1 + (1.f - 2.f * s1) * (float(i) + 0.5f) / kGrid;
         const float b = s2 + (1.f - 2.f * s2) * (float(j) + 0.5f) / kGrid;
         const Eigen::Vector3f p = o + a * e1 + b * e2;
-        const bool seen = (*observable)(p);
-        const Kind kind = kind_of(p, face / 6, int(face % 6) / 2);
-        if (kind == Kind::kHidden) {
-          ++hidden;
-          hidden_seen += seen;
-        } else if (kind == Kind::kExposed) {
-          ++face_exposed;
-          face_seen += seen;
-        }
+        points.push_back(p);
+        probes.push_back({face, kind_of(p, face / 6, int(face % 6) / 2)});
       }
-    exposed += face_exposed;
-    exposed_seen += face_seen;
-    if (face_exposed > 0) {
-      EXPECT_GE(double(face_seen) / double(face_exposed), kMinExposedSeenPerFace)
+  }
+  const std::vector<uint8_t> seen = (*observable)(points);
+  ASSERT_EQ(seen.size(), points.size());
+  const size_t faces = mesh.num_triangles() / 2;
+  std::vector<size_t> face_exposed(faces, 0), face_seen(faces, 0);
+  size_t exposed = 0, exposed_seen = 0, hidden = 0, hidden_seen = 0;
+  for (size_t k = 0; k < probes.size(); ++k) {
+    if (probes[k].kind == Kind::kHidden) {
+      ++hidden;
+      hidden_seen += seen[k];
+    } else if (probes[k].kind == Kind::kExposed) {
+      ++face_exposed[probes[k].face];
+      face_seen[probes[k].face] += seen[k];
+    }
+  }
+  for (size_t face = 0; face < faces; ++face) {
+    exposed += face_exposed[face];
+    exposed_seen += face_seen[face];
+    if (face_exposed[face] > 0) {
+      EXPECT_GE(double(face_seen[face]) / double(face_exposed[face]), kMinExposedSeenPerFace)
           << "box " << face / 6 << " face " << face % 6;
     }
   }

@@ -80,7 +80,7 @@ TEST(EvaluateMesh, GroundTruthFilterRestrictsCompleteness) {
   EXPECT_EQ(unfiltered->ground_truth_samples, unfiltered->ground_truth_samples_all);
 
   // Only the half that was reconstructed counts: complete there, half complete overall.
-  params.ground_truth_filter = [](const Eigen::Vector3f& p) { return p.x() < 0.5f; };
+  params.ground_truth_filter = KeepEach([](const Eigen::Vector3f& p) { return p.x() < 0.5f; });
   auto filtered = EvaluateMesh(half, UnitSquare(), params);
   ASSERT_TRUE(filtered.ok()) << filtered.status().message();
   EXPECT_DOUBLE_EQ(filtered->completeness, 1.0);
@@ -92,12 +92,12 @@ TEST(EvaluateMesh, GroundTruthFilterRestrictsCompleteness) {
   EXPECT_EQ(filtered->accuracy_rms_m, unfiltered->accuracy_rms_m);
 
   // The other half only: nothing of it was reconstructed.
-  params.ground_truth_filter = [](const Eigen::Vector3f& p) { return p.x() > 0.51f; };
+  params.ground_truth_filter = KeepEach([](const Eigen::Vector3f& p) { return p.x() > 0.51f; });
   auto other = EvaluateMesh(half, UnitSquare(), params);
   ASSERT_TRUE(other.ok());
   EXPECT_DOUBLE_EQ(other->completeness, 0.0);
 
-  params.ground_truth_filter = [](const Eigen::Vector3f&) { return false; };
+  params.ground_truth_filter = KeepEach([](const Eigen::Vector3f&) { return false; });
   auto none = EvaluateMesh(half, UnitSquare(), params);
   ASSERT_FALSE(none.ok());
   EXPECT_EQ(none.status().code(), StatusCode::kInvalidArgument);
