@@ -5,7 +5,6 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
-#include <cstring>
 #include <functional>
 #include <random>
 #include <tuple>
@@ -326,21 +325,12 @@ TEST(Raycast, OneAndTwoThreadsGiveIdenticalBytes) {
     two = Raycast(volume, cam, T_W_C);
   }
   ASSERT_GT(Count(one, RayStatus::kHit), 10000u);
-  auto same = [](const auto& a, const auto& b) {
-    return a.data.size() == b.data.size() &&
-           std::memcmp(a.data.data(), b.data.data(), a.data.size() * sizeof(a.data[0])) == 0;
-  };
-  EXPECT_TRUE(same(one.depth, two.depth));
-  EXPECT_TRUE(same(one.vertex_W, two.vertex_W));
-  EXPECT_TRUE(same(one.normal_W, two.normal_W));
-  EXPECT_TRUE(same(one.color, two.color));
-  EXPECT_TRUE(same(one.status, two.status));
+  test::ExpectSameImages(one, two);
 
   // Reusing images gives the same bytes again.
   RaycastImages reused = one;
   Raycast(volume, cam, T_W_C, {}, reused);
-  EXPECT_TRUE(same(one.depth, reused.depth));
-  EXPECT_TRUE(same(one.normal_W, reused.normal_W));
+  test::ExpectSameImages(one, reused);
 }
 
 // The AVX2 packet march against the scalar reference march on a noisy volume (random TSDF
@@ -382,15 +372,7 @@ TEST(Raycast, PacketMarchMatchesTheScalarMarchExactly) {
       scalar_params.simd = false;
       const RaycastImages scalar = Raycast(volume, cam, T_W_C, scalar_params);
       const RaycastImages packets = Raycast(volume, cam, T_W_C, packet_params);
-      auto same = [](const auto& a, const auto& b) {
-        return a.data.size() == b.data.size() &&
-               std::memcmp(a.data.data(), b.data.data(), a.data.size() * sizeof(a.data[0])) == 0;
-      };
-      EXPECT_TRUE(same(scalar.status, packets.status));
-      EXPECT_TRUE(same(scalar.depth, packets.depth));
-      EXPECT_TRUE(same(scalar.vertex_W, packets.vertex_W));
-      EXPECT_TRUE(same(scalar.normal_W, packets.normal_W));
-      EXPECT_TRUE(same(scalar.color, packets.color));
+      test::ExpectSameImages(scalar, packets);
       hits += Count(scalar, RayStatus::kHit);
       misses += Count(scalar, RayStatus::kFree) + Count(scalar, RayStatus::kUnobserved);
     }

@@ -197,6 +197,18 @@ void FuseFirstFrame(const Eigen::Vector2f& start, TsdfVolume& volume, PlanningMa
   ASSERT_GT(floor.width(), 0);
 }
 
+// The small apartment's volume, planning map and floor map after one frame from the first start.
+struct OneFrame {
+  const Scene& s = SmallApartment();
+  const ExploreParams params = FastParams();
+  const Eigen::Vector2f start =
+      ChooseStarts(s.plan, s.world.rooms, 1, params.robot.radius_m).value()[0];
+  TsdfVolume volume{VolumeParams{0.05f, 0.15f}};
+  PlanningMap map{volume};
+  FloorMap floor{0.05f, params.floor};
+  OneFrame() { FuseFirstFrame(start, volume, map, floor); }
+};
+
 // A plain heap Dijkstra over the 16 moves of core/geodesic.h (the cells a move crosses must be
 // traversable too), summing float move costs in cells and scaling at the end as GeodesicField
 // does: the same arithmetic, so its distances are the exact ones to expect.
@@ -243,14 +255,11 @@ std::vector<float> ReferenceField(const PlannerFloor& f, float min_clearance_m,
 }
 
 TEST(ExploreWorld, PadsTheFloorWithUnknownAndFreesCellsUnderRobots) {
-  const Scene& s = SmallApartment();
-  const ExploreParams params = FastParams();
-  const Eigen::Vector2f start =
-      ChooseStarts(s.plan, s.world.rooms, 1, params.robot.radius_m).value()[0];
-  TsdfVolume volume(VolumeParams{0.05f, 0.15f});
-  PlanningMap map(volume);
-  FloorMap floor(0.05f, params.floor);
-  FuseFirstFrame(start, volume, map, floor);
+  OneFrame one;
+  const ExploreParams& params = one.params;
+  const Eigen::Vector2f start = one.start;
+  PlanningMap& map = one.map;
+  FloorMap& floor = one.floor;
 
   ExploreWorldParams wp;
   wp.unknown_margin_m = 1.0f;
@@ -299,15 +308,9 @@ TEST(ExploreWorld, PadsTheFloorWithUnknownAndFreesCellsUnderRobots) {
 }
 
 TEST(ExploreWorld, GeodesicFieldsOfRobotsAreExactDijkstraDistances) {
-  const Scene& s = SmallApartment();
-  const ExploreParams params = FastParams();
-  const Eigen::Vector2f start =
-      ChooseStarts(s.plan, s.world.rooms, 1, params.robot.radius_m).value()[0];
-  TsdfVolume volume(VolumeParams{0.05f, 0.15f});
-  PlanningMap map(volume);
-  FloorMap floor(0.05f, params.floor);
-  FuseFirstFrame(start, volume, map, floor);
-  ExploreWorld world(map, floor, {});
+  OneFrame one;
+  const ExploreParams& params = one.params;
+  ExploreWorld world(one.map, one.floor, {});
   world.Refresh();
   const PlannerFloor& f = world.Floor();
 

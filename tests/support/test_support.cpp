@@ -1,10 +1,12 @@
 #include "tests/support/test_support.h"
 
+#include <gtest/gtest.h>
 #include <unistd.h>
 
 #include <atomic>
 #include <cmath>
 #include <cstdlib>
+#include <cstring>
 #include <limits>
 
 namespace voxplan::test {
@@ -119,6 +121,18 @@ TsdfVolume FillExactSdf(const std::function<float(const Eigen::Vector3f&)>& sdf,
         }
       }
   return volume;
+}
+
+void ExpectSameImages(const RaycastImages& a, const RaycastImages& b) {
+  auto same = [](const auto& x, const auto& y) {
+    return x.data.size() == y.data.size() &&
+           std::memcmp(x.data.data(), y.data.data(), x.data.size() * sizeof(x.data[0])) == 0;
+  };
+  EXPECT_TRUE(same(a.status, b.status)) << "status";
+  EXPECT_TRUE(same(a.depth, b.depth)) << "depth";
+  EXPECT_TRUE(same(a.vertex_W, b.vertex_W)) << "vertex_W";
+  EXPECT_TRUE(same(a.normal_W, b.normal_W)) << "normal_W";
+  EXPECT_TRUE(same(a.color, b.color)) << "color";
 }
 
 }  // namespace voxplan::test

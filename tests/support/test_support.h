@@ -9,6 +9,7 @@
 #include "core/camera.h"
 #include "core/image.h"
 #include "core/pose.h"
+#include "core/raycast.h"
 #include "core/volume.h"
 
 namespace voxplan::test {
@@ -58,5 +59,9 @@ TsdfVolume FillExactSdf(const std::function<float(const Eigen::Vector3f&)>& sdf,
                         const Eigen::Vector3f& hi, bool all_blocks = false);
 
 using voxplan::LookAt;  // core/pose.h; tests may still write test::LookAt
+
+// Every image of two ray casts is the same, byte for byte (NaNs included); a failure names the
+// image.
+void ExpectSameImages(const RaycastImages& a, const RaycastImages& b);
 
 }  // namespace voxplan::test

@@ -7,7 +7,6 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
-#include <cstring>
 #include <memory>
 #include <vector>
 
@@ -124,15 +123,7 @@ TEST(EndToEnd, IclNuimRaycastPacketsMatchTheScalarMarchExactly) {
       scalar_params.simd = false;
       const RaycastImages scalar = Raycast(*icl.volume, icl.camera, T_W_C, scalar_params);
       const RaycastImages packets = Raycast(*icl.volume, icl.camera, T_W_C, packet_params);
-      auto same = [](const auto& a, const auto& b) {
-        return a.data.size() == b.data.size() &&
-               std::memcmp(a.data.data(), b.data.data(), a.data.size() * sizeof(a.data[0])) == 0;
-      };
-      EXPECT_TRUE(same(scalar.status, packets.status));
-      EXPECT_TRUE(same(scalar.depth, packets.depth));
-      EXPECT_TRUE(same(scalar.vertex_W, packets.vertex_W));
-      EXPECT_TRUE(same(scalar.normal_W, packets.normal_W));
-      EXPECT_TRUE(same(scalar.color, packets.color));
+      test::ExpectSameImages(scalar, packets);
       hits += size_t(std::count(scalar.status.data.begin(), scalar.status.data.end(),
                                 uint8_t(RayStatus::kHit)));
     }
