@@ -126,13 +126,15 @@ constexpr BlockIndex FromOrderedKey(uint64_t k) {
 std::vector<BlockIndex> MergeToSortedBlocks(std::vector<std::vector<uint64_t>>& runs) {
   while (runs.size() > 1) {
     std::vector<std::vector<uint64_t>> merged((runs.size() + 1) / 2);
-    for (size_t i = 0; i + 1 < runs.size(); i += 2) {
-      const auto& x = runs[i];
-      const auto& y = runs[i + 1];
-      std::vector<uint64_t>& out = merged[i / 2];
-      out.resize(x.size() + y.size());
-      out.erase(std::set_union(x.begin(), x.end(), y.begin(), y.end(), out.begin()), out.end());
-    }
+    ParallelFor(runs.size() / 2, 1, [&](size_t begin, size_t end) {
+      for (size_t pair = begin; pair < end; ++pair) {
+        const auto& x = runs[2 * pair];
+        const auto& y = runs[2 * pair + 1];
+        std::vector<uint64_t>& out = merged[pair];
+        out.resize(x.size() + y.size());
+        out.erase(std::set_union(x.begin(), x.end(), y.begin(), y.end(), out.begin()), out.end());
+      }
+    });
     if (runs.size() % 2) merged.back() = std::move(runs.back());
     runs = std::move(merged);
   }
@@ -377,7 +379,13 @@ Result<IntegrateStats> IntegrateFrame(const DepthImage& depth, const ColorImage&
                           ? internal::IntegrateBlockSimd
                           : internal::IntegrateBlockScalar;
   ParallelFor(band.size(), 16, [&](size_t begin, size_t end) {
-    for (size_t i = begin; i < end; ++i) kernel(f, band[i], *blocks[i]);
+    for (size_t i = begin; i < end; ++i) {
+      if (i + 1 < end) {
+        const char* next = reinterpret_cast<const char*>(blocks[i + 1]);
+        for (size_t o = 0; o < sizeof(TsdfBlock); o += 64) __builtin_prefetch(next + o, 1);
+      }
+      kernel(f, band[i], *blocks[i]);
+    }
   });
   stats.update_ms = MsSince(t0);
   if (params.carve_free_space) {
