@@ -172,6 +172,31 @@ class KeyCollector {
   std::vector<uint64_t> keys_;
 };
 
+// Pairs of band end blocks seen lately: a direct-mapped cache, so a pair may be forgotten (and
+// walked again), never wrongly remembered.
+class EndPairCache {
+ public:
+  EndPairCache() : slots_(size_t(1) << kBits) {}
+  void Clear() { std::fill(slots_.begin(), slots_.end(), Slot{}); }
+  // False when the pair is in the cache; else remembers it.
+  bool Insert(BlockIndex a, BlockIndex b) {
+    if (!InPackRange(a) || !InPackRange(b)) return true;
+    const uint64_t ka = OrderedKey(a), kb = OrderedKey(b);
+    Slot& slot =
+        slots_[((ka * 0x9E3779B97F4A7C15ull) ^ (kb * 0xC2B2AE3D27D4EB4Full)) >> (64 - kBits)];
+    if (slot.a == ka && slot.b == kb) return false;
+    slot = {ka, kb};
+    return true;
+  }
+
+ private:
+  static constexpr int kBits = 10;
+  struct Slot {
+    uint64_t a = ~0ull, b = ~0ull;  // never a key: keys use 63 bits
+  };
+  std::vector<Slot> slots_;
+};
+
 // The band of every valid pixel, or with `carve` everything from min depth through the band.
 std::vector<BlockIndex> CollectBlocks(const DepthImage& depth, const PinholeCamera& camera,
                                       const Pose3f& T_W_C, const IntegrateParams& params,
@@ -251,11 +276,12 @@ std::vector<BlockIndex> CollectBlocks(const DepthImage& depth, const PinholeCame
   const auto candidates = ResolveKernel(params.kernel) == Kernel::kSimd
                               ? internal::BandRowCandidatesSimd
                               : internal::BandRowCandidatesScalar;
-  constexpr size_t kRowsPerTask = 8;
+  constexpr size_t kRowsPerTask = 16;
   const size_t tasks = (size_t(depth.height) + kRowsPerTask - 1) / kRowsPerTask;
   ParallelFor(tasks, 1, [&](size_t begin, size_t end) {
     KeyCollector collector;
     auto add = [&](BlockIndex b) { collector.Add(b); };
+    EndPairCache walked;
     std::vector<internal::BandCandidate> kept(size_t(depth.width));
     size_t task_valid = 0;
     internal::BandRow row;
@@ -268,21 +294,21 @@ std::vector<BlockIndex> CollectBlocks(const DepthImage& depth, const PinholeCame
       row.origin[k] = origin_b[k];
     }
     for (size_t task = begin; task < end; ++task) {
+      // Rows below one another mostly repeat the bands' end blocks: a pair of end blocks already
+      // walked in this task (as the row filter does along a row) is not walked again. Per task,
+      // so that the result does not depend on how tasks are split among threads.
+      walked.Clear();
       const int v_end = std::min<int>(depth.height, int((task + 1) * kRowsPerTask));
       for (int v = int(task * kRowsPerTask); v < v_end; ++v) {
         const Eigen::Vector3f row_b = d0_b + dv_b * float(v);
         for (int k = 0; k < 3; ++k) row.row[k] = row_b[k];
         row.depth = &depth.data[size_t(v) * size_t(depth.width)];
         const int n = candidates(row, kept.data(), &task_valid);
-        BlockIndex prev_a{kMaxBlockCoord + 1, 0, 0}, prev_b = prev_a;
         for (int i = 0; i < n; ++i) {
           const internal::BandCandidate& c = kept[size_t(i)];
           const BlockIndex ba{FloorToInt(c.a[0]), FloorToInt(c.a[1]), FloorToInt(c.a[2])};
           const BlockIndex bb{FloorToInt(c.b[0]), FloorToInt(c.b[1]), FloorToInt(c.b[2])};
-          // Candidates apart may still start and end in the same blocks as the previous one.
-          if (ba == prev_a && bb == prev_b) continue;
-          prev_a = ba;
-          prev_b = bb;
+          if (!walked.Insert(ba, bb)) continue;
           // The band is about a block long at 1 cm voxels: mostly it stays in one block or
           // crosses one face, and then the traversal is exactly {ba, bb} without stepping.
           const int steps = std::abs(ba.x - bb.x) + std::abs(ba.y - bb.y) + std::abs(ba.z - bb.z);
