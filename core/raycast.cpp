@@ -27,11 +27,13 @@
 namespace voxplan {
 namespace {
 
-constexpr int kRangeCell = 8;      // pixels per side of a range-image cell
-constexpr int kSurfaceCell = 2;    // pixels per side of a surface-range cell
-constexpr int kTile = 16;          // pixels per side of one parallel work item
-constexpr int kLanes = 4;          // rays the scalar march interleaves
-constexpr int kPacket = 8;         // rays an AVX2 packet marches
+constexpr int kRangeCell = 8;    // pixels per side of a range-image cell
+constexpr int kSurfaceCell = 2;  // pixels per side of a surface-range cell
+constexpr int kTile = 16;        // pixels per side of one parallel work item
+constexpr int kLanes = 4;        // rays the scalar march interleaves
+constexpr int kPacket = 8;       // rays an AVX2 packet marches
+constexpr int kPackets = 2;      // packets a worker marches side by side (overlaps latencies)
+constexpr int kPacketLanes = kPacket * kPackets;
 constexpr int kTilesPerBatch = 4;  // tiles whose rays feed one march (fewer idle lanes at the end)
 // Step as a fraction of the stored distance: the nearest voxel's centre can be up to 0.87 voxel
 // from the sample, and the negative band behind a surface is what catches an overshoot.
@@ -731,18 +733,21 @@ class RayCaster {
   // would take, with the same float operations in the same order (no FMA: the file is built
   // with -ffp-contract=off), so the images are identical to MarchInterleaved's. The steps have
   // no per-ray branch; block lookups, crossings (Refine, scalar: gathering its cells lane by
-  // lane measured no faster on AVX2) and new rays are handled lane by lane.
+  // lane measured no faster on AVX2) and new rays are handled lane by lane. A worker marches
+  // kPackets packets in turn, so that one packet's gathers and lookups overlap another's.
   template <class Write>
   VOXPLAN_TARGET_AVX2 void MarchPackets(const RayTask* tasks, size_t num_tasks, Write&& write) {
     struct alignas(32) Lanes {
-      float z[kPacket], z_end[kPacket], voxel_z[kPacket], step_z[kPacket], prev_z[kPacket];
-      float dir_vox[3][kPacket], dir_W[3][kPacket];
-      int32_t block_index[3][kPacket];
-      int32_t prev_tsdf[kPacket], tsdf[kPacket];
-      int32_t live[kPacket], has_block[kPacket], have_prev[kPacket], met[kPacket];  // 0 or -1
-      const TsdfBlock* block[kPacket];
-      size_t pixel[kPacket];
-      float z_restart[kPacket];
+      float z[kPacketLanes], z_end[kPacketLanes], voxel_z[kPacketLanes], step_z[kPacketLanes],
+          prev_z[kPacketLanes];
+      float dir_vox[3][kPacketLanes], dir_W[3][kPacketLanes];
+      int32_t block_index[3][kPacketLanes];
+      int32_t prev_tsdf[kPacketLanes], tsdf[kPacketLanes];
+      int32_t live[kPacketLanes], has_block[kPacketLanes], have_prev[kPacketLanes],
+          met[kPacketLanes];  // 0 or -1
+      const TsdfBlock* block[kPacketLanes];
+      size_t pixel[kPacketLanes];
+      float z_restart[kPacketLanes];
     } lanes;
     std::memset(&lanes, 0, sizeof(lanes));
     for (auto& block : lanes.block) block = &kNoBlock;
@@ -787,7 +792,7 @@ class RayCaster {
       return start_next(l);
     };
     int num_live = 0;
-    for (int l = 0; l < kPacket; ++l) num_live += start_next(l);
+    for (int l = 0; l < kPacketLanes; ++l) num_live += start_next(l);
 
     const __m256 origin_vox[3] = {_mm256_set1_ps(origin_vox_.x()), _mm256_set1_ps(origin_vox_.y()),
                                   _mm256_set1_ps(origin_vox_.z())};
@@ -801,111 +806,116 @@ class RayCaster {
     const __m256i stop_at_back_faces = params_.stop_at_back_faces ? minus_one : zero;
 
     while (num_live > 0) {
-      const __m256i live = avx2::Load(lanes.live);
-      const __m256 z = avx2::LoadF(lanes.z);
-      const __m256i in_range = _mm256_and_si256(
-          live, _mm256_castps_si256(_mm256_cmp_ps(z, avx2::LoadF(lanes.z_end), _CMP_LE_OQ)));
-      // The sample's voxel and block, as Step computes them.
-      __m256i g[3], changed = zero;
-      for (int a = 0; a < 3; ++a) {
-        const __m256 p =
-            _mm256_add_ps(origin_vox[a], _mm256_mul_ps(z, avx2::LoadF(lanes.dir_vox[a])));
-        g[a] = avx2::Floor(p);
-        const __m256i b = _mm256_srai_epi32(g[a], kBlockShift);
-        changed = _mm256_or_si256(
-            changed,
-            avx2::AndNot(_mm256_cmpeq_epi32(b, avx2::Load(lanes.block_index[a])), minus_one));
-        avx2::Store(lanes.block_index[a], b);  // lanes out of range never read it again
-      }
-      changed = _mm256_and_si256(changed, in_range);
-      for (int bits = _mm256_movemask_ps(_mm256_castsi256_ps(changed)); bits; bits &= bits - 1) {
-        const int l = std::countr_zero(unsigned(bits));
-        const TsdfBlock* block = sampler_.FindUncached(
-            BlockIndex{lanes.block_index[0][l], lanes.block_index[1][l], lanes.block_index[2][l]});
-        lanes.has_block[l] = block ? -1 : 0;
-        lanes.block[l] = block ? block : &kNoBlock;
-      }
-      // tsdf[i] and weight[i] of each lane's block (two bytes more are read, inside the block).
-      const __m256i i = avx2::LinearIndex(g);
-      const __m256i offset_tsdf = _mm256_add_epi32(i, i);
-      const __m256i tsdf =
-          _mm256_srai_epi32(_mm256_slli_epi32(avx2::Gather32(lanes.block, offset_tsdf), 16), 16);
-      const __m256i weight = _mm256_and_si256(
-          avx2::Gather32(lanes.block,
-                         _mm256_add_epi32(offset_tsdf, _mm256_set1_epi32(kWeightOffset))),
-          _mm256_set1_epi32(0xffff));
-
-      const __m256i has_block = avx2::Load(lanes.has_block);
-      const __m256i no_block = avx2::AndNot(has_block, in_range);
-      const __m256i observed = _mm256_and_si256(_mm256_and_si256(in_range, has_block),
-                                                _mm256_cmpgt_epi32(weight, min_weight_minus_one));
-      const __m256i unobserved = avx2::AndNot(observed, _mm256_and_si256(in_range, has_block));
-      const __m256i have_prev = avx2::Load(lanes.have_prev);
-      const __m256i prev_tsdf = avx2::Load(lanes.prev_tsdf);
-      const __m256i tsdf_nonneg = _mm256_cmpgt_epi32(tsdf, minus_one);
-      const __m256i cross =
-          _mm256_and_si256(_mm256_and_si256(observed, have_prev),
-                           _mm256_xor_si256(_mm256_cmpgt_epi32(prev_tsdf, minus_one), tsdf_nonneg));
-      const __m256i back_face = _mm256_and_si256(cross, tsdf_nonneg);
-      const __m256i stop = _mm256_and_si256(back_face, stop_at_back_faces);
-      const __m256i front_face = avx2::AndNot(tsdf_nonneg, cross);  // refined below
-      const __m256i advance = avx2::AndNot(cross, observed);
-      const __m256i one_voxel = _mm256_or_si256(unobserved, avx2::AndNot(stop, back_face));
-
-      // Where a lane without a block leaves it (nudged past the face).
-      __m256 z_exit = inf;
-      for (int a = 0; a < 3; ++a) {
-        const __m256 d = avx2::LoadF(lanes.dir_W[a]);
-        const __m256i face = _mm256_sub_epi32(
-            avx2::Load(lanes.block_index[a]),
-            _mm256_castps_si256(_mm256_cmp_ps(d, _mm256_setzero_ps(), _CMP_GT_OQ)));
-        __m256 t = _mm256_div_ps(
-            _mm256_sub_ps(_mm256_mul_ps(_mm256_cvtepi32_ps(face), block_m), origin_W[a]), d);
-        t = _mm256_blendv_ps(t, inf, _mm256_cmp_ps(d, _mm256_setzero_ps(), _CMP_EQ_OQ));
-        z_exit = _mm256_min_ps(t, z_exit);
-      }
-      const __m256 voxel_z = avx2::LoadF(lanes.voxel_z);
-      const __m256 tsdf_f = _mm256_cvtepi32_ps(tsdf);
-      __m256 z_next = z;
-      z_next = avx2::Blend(
-          z_next,
-          _mm256_add_ps(_mm256_max_ps(z, z_exit), _mm256_mul_ps(_mm256_set1_ps(0.01f), voxel_z)),
-          no_block);
-      z_next = avx2::Blend(z_next, _mm256_add_ps(z, voxel_z), one_voxel);
-      z_next = avx2::Blend(
-          z_next,
-          _mm256_add_ps(z,
-                        _mm256_max_ps(voxel_z, _mm256_mul_ps(tsdf_f, avx2::LoadF(lanes.step_z)))),
-          advance);
-      _mm256_storeu_ps(lanes.z, z_next);
-      _mm256_storeu_ps(lanes.prev_z, avx2::Blend(avx2::LoadF(lanes.prev_z), z, advance));
-      avx2::Store(lanes.prev_tsdf, _mm256_blendv_epi8(prev_tsdf, tsdf, advance));
-      avx2::Store(lanes.tsdf, tsdf);
-      // have_prev: set by an advance, cleared by a jump or a one-voxel step, kept otherwise.
-      const __m256i cleared = _mm256_or_si256(no_block, one_voxel);
-      avx2::Store(lanes.have_prev, _mm256_or_si256(advance, avx2::AndNot(cleared, have_prev)));
-      avx2::Store(lanes.met, _mm256_or_si256(avx2::Load(lanes.met), observed));
-
-      const __m256i done =
-          _mm256_or_si256(avx2::AndNot(in_range, live), _mm256_or_si256(stop, front_face));
-      const int front_bits = _mm256_movemask_ps(_mm256_castsi256_ps(front_face));
-      for (int bits = _mm256_movemask_ps(_mm256_castsi256_ps(done)); bits; bits &= bits - 1) {
-        const int l = std::countr_zero(unsigned(bits));
-        const Eigen::Vector3f dir_W(lanes.dir_W[0][l], lanes.dir_W[1][l], lanes.dir_W[2][l]);
-        RayResult result;
-        if (lanes.met[l]) result.status = RayStatus::kFree;
-        if (((front_bits >> l) & 1) &&
-            !Cross(dir_W, lanes.prev_z[l], lanes.z[l], int16_t(lanes.prev_tsdf[l]),
-                   int16_t(lanes.tsdf[l]), lanes.voxel_z[l], &result)) {
-          // The nearest values disagree with the interpolant (noise): march on, as Step does.
-          const int16_t tsdf = int16_t(lanes.tsdf[l]);
-          lanes.have_prev[l] = -1;
-          lanes.prev_z[l] = lanes.z[l];
-          lanes.prev_tsdf[l] = tsdf;
-          lanes.z[l] += std::max(float(tsdf) * lanes.step_z[l], lanes.voxel_z[l]);
-          continue;
+      for (int base = 0; base < kPacketLanes; base += kPacket) {  // lanes [base, base + 8)
+        const __m256i live = avx2::Load(lanes.live + base);
+        const __m256 z = avx2::LoadF(lanes.z + base);
+        const __m256i in_range = _mm256_and_si256(
+            live,
+            _mm256_castps_si256(_mm256_cmp_ps(z, avx2::LoadF(lanes.z_end + base), _CMP_LE_OQ)));
+        // The sample's voxel and block, as Step computes them.
+        __m256i g[3], changed = zero;
+        for (int a = 0; a < 3; ++a) {
+          const __m256 p =
+              _mm256_add_ps(origin_vox[a], _mm256_mul_ps(z, avx2::LoadF(lanes.dir_vox[a] + base)));
+          g[a] = avx2::Floor(p);
+          const __m256i b = _mm256_srai_epi32(g[a], kBlockShift);
+          changed = _mm256_or_si256(
+              changed, avx2::AndNot(_mm256_cmpeq_epi32(b, avx2::Load(lanes.block_index[a] + base)),
+                                    minus_one));
+          avx2::Store(lanes.block_index[a] + base, b);  // lanes out of range never read it again
         }
-        num_live -= !finish(l, dir_W, result);
+        changed = _mm256_and_si256(changed, in_range);
+        for (int bits = _mm256_movemask_ps(_mm256_castsi256_ps(changed)); bits; bits &= bits - 1) {
+          const int l = base + std::countr_zero(unsigned(bits));
+          const TsdfBlock* block = sampler_.FindUncached(BlockIndex{
+              lanes.block_index[0][l], lanes.block_index[1][l], lanes.block_index[2][l]});
+          lanes.has_block[l] = block ? -1 : 0;
+          lanes.block[l] = block ? block : &kNoBlock;
+        }
+        // tsdf[i] and weight[i] of each lane's block (two bytes more are read, inside the block).
+        const __m256i i = avx2::LinearIndex(g);
+        const __m256i offset_tsdf = _mm256_add_epi32(i, i);
+        const __m256i tsdf = _mm256_srai_epi32(
+            _mm256_slli_epi32(avx2::Gather32(lanes.block + base, offset_tsdf), 16), 16);
+        const __m256i weight = _mm256_and_si256(
+            avx2::Gather32(lanes.block + base,
+                           _mm256_add_epi32(offset_tsdf, _mm256_set1_epi32(kWeightOffset))),
+            _mm256_set1_epi32(0xffff));
+
+        const __m256i has_block = avx2::Load(lanes.has_block + base);
+        const __m256i no_block = avx2::AndNot(has_block, in_range);
+        const __m256i observed = _mm256_and_si256(_mm256_and_si256(in_range, has_block),
+                                                  _mm256_cmpgt_epi32(weight, min_weight_minus_one));
+        const __m256i unobserved = avx2::AndNot(observed, _mm256_and_si256(in_range, has_block));
+        const __m256i have_prev = avx2::Load(lanes.have_prev + base);
+        const __m256i prev_tsdf = avx2::Load(lanes.prev_tsdf + base);
+        const __m256i tsdf_nonneg = _mm256_cmpgt_epi32(tsdf, minus_one);
+        const __m256i cross = _mm256_and_si256(
+            _mm256_and_si256(observed, have_prev),
+            _mm256_xor_si256(_mm256_cmpgt_epi32(prev_tsdf, minus_one), tsdf_nonneg));
+        const __m256i back_face = _mm256_and_si256(cross, tsdf_nonneg);
+        const __m256i stop = _mm256_and_si256(back_face, stop_at_back_faces);
+        const __m256i front_face = avx2::AndNot(tsdf_nonneg, cross);  // refined below
+        const __m256i advance = avx2::AndNot(cross, observed);
+        const __m256i one_voxel = _mm256_or_si256(unobserved, avx2::AndNot(stop, back_face));
+
+        // Where a lane without a block leaves it (nudged past the face).
+        __m256 z_exit = inf;
+        for (int a = 0; a < 3; ++a) {
+          const __m256 d = avx2::LoadF(lanes.dir_W[a] + base);
+          const __m256i face = _mm256_sub_epi32(
+              avx2::Load(lanes.block_index[a] + base),
+              _mm256_castps_si256(_mm256_cmp_ps(d, _mm256_setzero_ps(), _CMP_GT_OQ)));
+          __m256 t = _mm256_div_ps(
+              _mm256_sub_ps(_mm256_mul_ps(_mm256_cvtepi32_ps(face), block_m), origin_W[a]), d);
+          t = _mm256_blendv_ps(t, inf, _mm256_cmp_ps(d, _mm256_setzero_ps(), _CMP_EQ_OQ));
+          z_exit = _mm256_min_ps(t, z_exit);
+        }
+        const __m256 voxel_z = avx2::LoadF(lanes.voxel_z + base);
+        const __m256 tsdf_f = _mm256_cvtepi32_ps(tsdf);
+        __m256 z_next = z;
+        z_next = avx2::Blend(
+            z_next,
+            _mm256_add_ps(_mm256_max_ps(z, z_exit), _mm256_mul_ps(_mm256_set1_ps(0.01f), voxel_z)),
+            no_block);
+        z_next = avx2::Blend(z_next, _mm256_add_ps(z, voxel_z), one_voxel);
+        z_next = avx2::Blend(
+            z_next,
+            _mm256_add_ps(
+                z, _mm256_max_ps(voxel_z, _mm256_mul_ps(tsdf_f, avx2::LoadF(lanes.step_z + base)))),
+            advance);
+        _mm256_storeu_ps(lanes.z + base, z_next);
+        _mm256_storeu_ps(lanes.prev_z + base,
+                         avx2::Blend(avx2::LoadF(lanes.prev_z + base), z, advance));
+        avx2::Store(lanes.prev_tsdf + base, _mm256_blendv_epi8(prev_tsdf, tsdf, advance));
+        avx2::Store(lanes.tsdf + base, tsdf);
+        // have_prev: set by an advance, cleared by a jump or a one-voxel step, kept otherwise.
+        const __m256i cleared = _mm256_or_si256(no_block, one_voxel);
+        avx2::Store(lanes.have_prev + base,
+                    _mm256_or_si256(advance, avx2::AndNot(cleared, have_prev)));
+        avx2::Store(lanes.met + base, _mm256_or_si256(avx2::Load(lanes.met + base), observed));
+
+        const __m256i done =
+            _mm256_or_si256(avx2::AndNot(in_range, live), _mm256_or_si256(stop, front_face));
+        const int front_bits = _mm256_movemask_ps(_mm256_castsi256_ps(front_face));
+        for (int bits = _mm256_movemask_ps(_mm256_castsi256_ps(done)); bits; bits &= bits - 1) {
+          const int l = base + std::countr_zero(unsigned(bits));
+          const Eigen::Vector3f dir_W(lanes.dir_W[0][l], lanes.dir_W[1][l], lanes.dir_W[2][l]);
+          RayResult result;
+          if (lanes.met[l]) result.status = RayStatus::kFree;
+          if (((front_bits >> (l - base)) & 1) &&
+              !Cross(dir_W, lanes.prev_z[l], lanes.z[l], int16_t(lanes.prev_tsdf[l]),
+                     int16_t(lanes.tsdf[l]), lanes.voxel_z[l], &result)) {
+            // The nearest values disagree with the interpolant (noise): march on, as Step does.
+            const int16_t tsdf = int16_t(lanes.tsdf[l]);
+            lanes.have_prev[l] = -1;
+            lanes.prev_z[l] = lanes.z[l];
+            lanes.prev_tsdf[l] = tsdf;
+            lanes.z[l] += std::max(float(tsdf) * lanes.step_z[l], lanes.voxel_z[l]);
+            continue;
+          }
+          num_live -= !finish(l, dir_W, result);
+        }
       }
     }
   }
