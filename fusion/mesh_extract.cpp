@@ -195,57 +195,110 @@ void MeshBlocks(const TsdfVolume& volume, const std::vector<BlockIndex>& blocks,
   });
 }
 
-// Welds per-block pieces, given in block order, into one mesh with area-weighted normals.
+// Exclusive prefix sums of count(i) over [0, n): out[i] is the sum of the counts before i.
+template <typename Count>
+std::vector<size_t> PrefixSums(size_t n, Count&& count) {
+  std::vector<size_t> out(n + 1, 0);
+  for (size_t i = 0; i < n; ++i) out[i + 1] = out[i] + count(i);
+  return out;
+}
+
+// Welds per-block pieces, given in block order, into one mesh with area-weighted normals. The
+// passes over pieces run in parallel; each writes where prefix sums over the pieces put it, so
+// the mesh is the same for any thread count.
 Mesh Assemble(const std::vector<const BlockMesh*>& parts, const MeshParams& params) {
+  const size_t num_parts = parts.size();
+  constexpr size_t kPartsPerTask = 64;
   // Weld: blocks meet on shared edges, which carry the same key and identical values. Only
   // vertices on block borders can be shared; the first in block order stands for all.
-  std::vector<size_t> offset(parts.size() + 1, 0);
-  for (size_t i = 0; i < parts.size(); ++i) offset[i + 1] = offset[i] + parts[i]->keys.size();
+  const std::vector<size_t> offset =
+      PrefixSums(num_parts, [&](size_t i) { return parts[i]->keys.size(); });
   const size_t total = offset.back();
-  std::vector<std::pair<uint64_t, uint32_t>> border;
-  for (size_t i = 0; i < parts.size(); ++i)
-    for (size_t k = 0; k < parts[i]->keys.size(); ++k)
-      if (parts[i]->shared[k]) border.emplace_back(parts[i]->keys[k], uint32_t(offset[i] + k));
-  std::sort(border.begin(), border.end());
+  const std::vector<size_t> border_offset = PrefixSums(num_parts, [&](size_t i) {
+    return size_t(std::count(parts[i]->shared.begin(), parts[i]->shared.end(), uint8_t{1}));
+  });
+  std::vector<std::pair<uint64_t, uint32_t>> border(border_offset.back());
   std::vector<uint32_t> canonical(total);
-  for (size_t k = 0; k < total; ++k) canonical[k] = uint32_t(k);
+  ParallelFor(num_parts, kPartsPerTask, [&](size_t begin, size_t end) {
+    for (size_t i = begin; i < end; ++i) {
+      size_t b = border_offset[i];
+      for (size_t k = 0; k < parts[i]->keys.size(); ++k) {
+        canonical[offset[i] + k] = uint32_t(offset[i] + k);
+        if (parts[i]->shared[k]) border[b++] = {parts[i]->keys[k], uint32_t(offset[i] + k)};
+      }
+    }
+  });
+  std::sort(border.begin(), border.end());
   for (size_t k = 1; k < border.size(); ++k)
     if (border[k].first == border[k - 1].first)
       canonical[border[k].second] = canonical[border[k - 1].second];
 
+  // Vertices: the canonical ones, in order; the others take their canonical vertex's id.
+  const std::vector<size_t> vertex_offset = PrefixSums(num_parts, [&](size_t i) {
+    size_t n = 0;
+    for (size_t k = 0; k < parts[i]->keys.size(); ++k)
+      n += canonical[offset[i] + k] == offset[i] + k;
+    return n;
+  });
   Mesh mesh;
-  mesh.positions.reserve(total);
-  if (params.with_color) mesh.colors.reserve(total);
+  mesh.positions.resize(vertex_offset.back());
+  if (params.with_color) mesh.colors.resize(vertex_offset.back());
   std::vector<uint32_t> welded(total);
-  for (size_t i = 0; i < parts.size(); ++i)
-    for (size_t k = 0; k < parts[i]->keys.size(); ++k) {
-      const size_t seq = offset[i] + k;
-      if (canonical[seq] != seq) {
-        welded[seq] = welded[canonical[seq]];
-        continue;
+  ParallelFor(num_parts, kPartsPerTask, [&](size_t begin, size_t end) {
+    for (size_t i = begin; i < end; ++i) {
+      size_t v = vertex_offset[i];
+      for (size_t k = 0; k < parts[i]->keys.size(); ++k) {
+        const size_t seq = offset[i] + k;
+        if (canonical[seq] != seq) continue;
+        welded[seq] = uint32_t(v);
+        mesh.positions[v] = parts[i]->positions[k];
+        if (params.with_color) mesh.colors[v] = parts[i]->colors[k];
+        ++v;
       }
-      welded[seq] = uint32_t(mesh.positions.size());
-      mesh.positions.push_back(parts[i]->positions[k]);
-      if (params.with_color) mesh.colors.push_back(parts[i]->colors[k]);
     }
-  for (size_t i = 0; i < parts.size(); ++i)
-    for (const auto& tri : parts[i]->triangles) {
-      const std::array<uint32_t, 3> t = {welded[offset[i] + tri[0]], welded[offset[i] + tri[1]],
-                                         welded[offset[i] + tri[2]]};
-      if (t[0] != t[1] && t[1] != t[2] && t[0] != t[2]) mesh.triangles.push_back(t);
-    }
+  });
+  // Canonical vertices come first in block order, so every one is numbered by now.
+  ParallelFor(num_parts, kPartsPerTask, [&](size_t begin, size_t end) {
+    for (size_t seq = offset[begin]; seq < offset[end]; ++seq)
+      if (canonical[seq] != seq) welded[seq] = welded[canonical[seq]];
+  });
 
-  // Area-weighted vertex normals, accumulated in triangle order (deterministic).
+  // Triangles, welded in parallel; the few that welding made degenerate are dropped after.
+  const std::vector<size_t> triangle_offset =
+      PrefixSums(num_parts, [&](size_t i) { return parts[i]->triangles.size(); });
+  mesh.triangles.resize(triangle_offset.back());
+  auto degenerate = [](const std::array<uint32_t, 3>& t) {
+    return t[0] == t[1] || t[1] == t[2] || t[0] == t[2];
+  };
+  std::vector<uint8_t> any_degenerate(num_parts, 0);
+  ParallelFor(num_parts, kPartsPerTask, [&](size_t begin, size_t end) {
+    for (size_t i = begin; i < end; ++i) {
+      std::array<uint32_t, 3>* out = &mesh.triangles[triangle_offset[i]];
+      for (const auto& tri : parts[i]->triangles) {
+        *out = {welded[offset[i] + tri[0]], welded[offset[i] + tri[1]], welded[offset[i] + tri[2]]};
+        any_degenerate[i] |= uint8_t(degenerate(*out++));
+      }
+    }
+  });
+  if (std::count(any_degenerate.begin(), any_degenerate.end(), uint8_t{1}) > 0)
+    mesh.triangles.erase(std::remove_if(mesh.triangles.begin(), mesh.triangles.end(), degenerate),
+                         mesh.triangles.end());
+
+  // Area-weighted vertex normals, accumulated in triangle order (deterministic), normalised in
+  // parallel.
   mesh.normals.assign(mesh.positions.size(), Eigen::Vector3f::Zero());
   for (const auto& t : mesh.triangles) {
     const Eigen::Vector3f n = (mesh.positions[t[1]] - mesh.positions[t[0]])
                                   .cross(mesh.positions[t[2]] - mesh.positions[t[0]]);
     for (uint32_t v : t) mesh.normals[v] += n;
   }
-  for (auto& n : mesh.normals) {
-    const float len = n.norm();
-    n = len > 0.f ? Eigen::Vector3f(n / len) : Eigen::Vector3f::UnitZ();
-  }
+  ParallelFor(mesh.normals.size(), 4096, [&](size_t begin, size_t end) {
+    for (size_t v = begin; v < end; ++v) {
+      Eigen::Vector3f& n = mesh.normals[v];
+      const float len = n.norm();
+      n = len > 0.f ? Eigen::Vector3f(n / len) : Eigen::Vector3f::UnitZ();
+    }
+  });
   return mesh;
 }
 
