@@ -406,9 +406,12 @@ Result<IntegrateStats> IntegrateFrame(const DepthImage& depth, const ColorImage&
                           : internal::IntegrateBlockScalar;
   ParallelFor(band.size(), 16, [&](size_t begin, size_t end) {
     for (size_t i = begin; i < end; ++i) {
+      // Pool blocks are scattered and a frame's band outgrows the cache at 5 mm: fetch the next
+      // block (for writing) while this one is updated.
+      constexpr size_t kCacheLine = 64;
       if (i + 1 < end) {
         const char* next = reinterpret_cast<const char*>(blocks[i + 1]);
-        for (size_t o = 0; o < sizeof(TsdfBlock); o += 64) __builtin_prefetch(next + o, 1);
+        for (size_t o = 0; o < sizeof(TsdfBlock); o += kCacheLine) __builtin_prefetch(next + o, 1);
       }
       kernel(f, band[i], *blocks[i]);
     }

@@ -195,11 +195,17 @@ void MeshBlocks(const TsdfVolume& volume, const std::vector<BlockIndex>& blocks,
   });
 }
 
-// Exclusive prefix sums of count(i) over [0, n): out[i] is the sum of the counts before i.
+constexpr size_t kPartsPerTask = 64;  // block pieces per parallel task
+
+// Exclusive prefix sums of count(i) over [0, n), the counts taken in parallel: out[i] is the
+// sum of the counts before i, out[n] the total.
 template <typename Count>
 std::vector<size_t> PrefixSums(size_t n, Count&& count) {
   std::vector<size_t> out(n + 1, 0);
-  for (size_t i = 0; i < n; ++i) out[i + 1] = out[i] + count(i);
+  ParallelFor(n, kPartsPerTask, [&](size_t begin, size_t end) {
+    for (size_t i = begin; i < end; ++i) out[i + 1] = count(i);
+  });
+  for (size_t i = 0; i < n; ++i) out[i + 1] += out[i];
   return out;
 }
 
@@ -208,7 +214,6 @@ std::vector<size_t> PrefixSums(size_t n, Count&& count) {
 // the mesh is the same for any thread count.
 Mesh Assemble(const std::vector<const BlockMesh*>& parts, const MeshParams& params) {
   const size_t num_parts = parts.size();
-  constexpr size_t kPartsPerTask = 64;
   // Weld: blocks meet on shared edges, which carry the same key and identical values. Only
   // vertices on block borders can be shared; the first in block order stands for all.
   const std::vector<size_t> offset =
