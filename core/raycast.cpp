@@ -52,9 +52,8 @@ constexpr float kNaN = std::numeric_limits<float>::quiet_NaN();
 struct RangeImage {
   int cols = 0, rows = 0;
   std::vector<float> z_min, z_max;  // z_min > z_max where no block projects
-  // Per cell of kSurfaceCell^2 pixels, the nearest depth of the cubes of observed negative
-  // voxels: a surface crossing can only end in such a cube, so rays that can hit start just in
-  // front of it.
+  // Per cell of kSurfaceCell^2 pixels, the nearest depth of the cubes of negative voxels: a surface
+  // crossing can only end in such a cube, so rays that can hit start just in front of it.
   int surface_cols = 0, surface_rows = 0;
   std::vector<float> surface_z_min;
 };
@@ -63,37 +62,29 @@ struct Chunk {
   std::vector<float> z_min, z_max, surface_z_min;
 };
 
-// Bricks of kBrickSide^3 voxels: the unit at which observed negative voxels (behind a surface)
-// are splatted into the surface range image. kBrickSide = 2 gives 64 bricks, one bit each.
+// Bricks of kBrickSide^3 voxels: the unit at which negative voxels (behind a surface) are
+// splatted into the surface range image. kBrickSide = 2 gives 64 bricks, one bit each.
 constexpr int kBrickSide = 2;
 constexpr int kBricksPerSide = kBlockSide / kBrickSide;
 constexpr int kBricks = kBricksPerSide * kBricksPerSide * kBricksPerSide;
 static_assert(kBricks == 64);
 
-// Bit (bx + 4 by + 16 bz) set when brick (bx, by, bz) holds an observed voxel behind a surface
-// (negative distance). Depends on the block only, not the camera, and is two compares and a
-// movemask per x-row of voxels.
-uint64_t NegativeBrickMask(const TsdfBlock& block, uint16_t min_weight_fixed) {
+// Bit (bx + 4 by + 16 bz) set when brick (bx, by, bz) holds a voxel with a negative distance.
+// Fresh voxels are +1, so a negative one has been observed; its weight is not read (half the
+// bytes): under a raised RaycastParams::min_weight the mask only grows, which keeps the bound it
+// feeds a bound. Depends on the block only, not the camera; a compare and a movemask per x-row.
+uint64_t NegativeBrickMask(const TsdfBlock& block) {
   uint64_t mask = 0;
-#if defined(__SSE2__)
-  const __m128i zero = _mm_setzero_si128();
-  // Unsigned weight >= min as a signed compare: flip the sign bits of both sides.
-  const __m128i flip = _mm_set1_epi16(int16_t(0x8000));
-  const __m128i min_minus_one = _mm_set1_epi16(int16_t((min_weight_fixed - 1) ^ 0x8000));
-#endif
   for (int row = 0; row < kBlockSide * kBlockSide; ++row) {
     const int16_t* tsdf = block.tsdf + row * kBlockSide;
-    const uint16_t* weight = block.weight + row * kBlockSide;
 #if defined(__SSE2__)
+    const __m128i zero = _mm_setzero_si128();
     const __m128i t = _mm_loadu_si128(reinterpret_cast<const __m128i*>(tsdf));
-    const __m128i w = _mm_loadu_si128(reinterpret_cast<const __m128i*>(weight));
-    const __m128i negative = _mm_and_si128(_mm_cmplt_epi16(t, zero),
-                                           _mm_cmpgt_epi16(_mm_xor_si128(w, flip), min_minus_one));
-    const unsigned bits = unsigned(_mm_movemask_epi8(_mm_packs_epi16(negative, zero)));
+    const unsigned bits =
+        unsigned(_mm_movemask_epi8(_mm_packs_epi16(_mm_cmplt_epi16(t, zero), zero)));
 #else
     unsigned bits = 0;
-    for (int x = 0; x < kBlockSide; ++x)
-      bits |= unsigned(tsdf[x] < 0 && weight[x] >= min_weight_fixed) << x;
+    for (int x = 0; x < kBlockSide; ++x) bits |= unsigned(tsdf[x] < 0) << x;
 #endif
     if (!bits) continue;
     const unsigned pairs = (bits | (bits >> 1)) & 0x55u;  // bit 2k: voxel 2k or 2k + 1
@@ -110,6 +101,35 @@ uint64_t NegativeBrickMask(const TsdfBlock& block, uint16_t min_weight_fixed) {
 // is approached from its positive side (crossings in front of min_depth are not reported).
 float MarchStart(const TsdfVolume& volume, const RaycastParams& params) {
   return std::max(params.min_depth_m - volume.voxel_size_m(), 1e-3f);
+}
+
+// Pixels a box can cover: [u_lo, u_hi] x [v_lo, v_hi], whole pixels clipped to the image.
+struct PixelRange {
+  float u_lo, u_hi, v_lo, v_hi;
+};
+
+// The pixels that the part at z >= z_near of the camera-aligned box centre_C +- half_extent
+// can project to, half a pixel beyond to absorb rounding; false when none can. Over the box,
+// x / z is largest at the near face where x > 0 and at the far face otherwise (so for y).
+bool ProjectBox(const PinholeCamera& camera, const Eigen::Vector3f& centre_C,
+                const Eigen::Vector3f& half_extent, float z_near, PixelRange* pixels) {
+  const float z_front = std::max(centre_C.z() - half_extent.z(), z_near);
+  const float z_back = centre_C.z() + half_extent.z();
+  if (!(z_front <= z_back)) return false;
+  const float inv_front = 1.f / z_front, inv_back = 1.f / z_back;
+  constexpr float kPixelMargin = 0.5f;
+  auto range = [&](float c, float e, float f, float principal, int size, float* lo, float* hi) {
+    const float t_hi = (c + e) * (c + e >= 0.f ? inv_front : inv_back);
+    const float t_lo = (c - e) * (c - e >= 0.f ? inv_back : inv_front);
+    const float a = f * t_lo + principal, b = f * t_hi + principal;
+    *lo = std::max(std::ceil(std::min(a, b) - kPixelMargin), 0.f);
+    *hi = std::min(std::floor(std::max(a, b) + kPixelMargin), float(size - 1));
+    return *lo <= *hi;
+  };
+  return range(centre_C.x(), half_extent.x(), camera.fx, camera.cx, camera.width, &pixels->u_lo,
+               &pixels->u_hi) &&
+         range(centre_C.y(), half_extent.y(), camera.fy, camera.cy, camera.height, &pixels->v_lo,
+               &pixels->v_hi);
 }
 
 RangeImage BuildRangeImage(const TsdfVolume& volume, const PinholeCamera& camera,
@@ -131,9 +151,6 @@ RangeImage BuildRangeImage(const TsdfVolume& volume, const PinholeCamera& camera
     blocks.push_back(b);
     block_data.push_back(&data);
   });
-  const uint16_t min_weight_fixed =
-      uint16_t(std::clamp(std::ceil(params.min_weight * kWeightScale), 1.f, 65535.f));
-
   // Min and max are order-independent, so the chunking (and the thread count) cannot change
   // the result; each chunk owns its partial image, so nothing is shared while splatting.
   constexpr size_t kBlocksPerChunk = 1024;
@@ -144,20 +161,23 @@ RangeImage BuildRangeImage(const TsdfVolume& volume, const PinholeCamera& camera
   const Eigen::Vector3f axis_x = R_C_W.col(0) * block_m, axis_y = R_C_W.col(1) * block_m,
                         axis_z = R_C_W.col(2) * block_m;
   const float z_near = MarchStart(volume, params), z_far = params.max_depth_m;
-  // Pixels are admitted half a pixel beyond the projected box to absorb rounding.
-  constexpr float kPixelMargin = 0.5f;
-  // One voxel along each block axis, in the camera frame; half a voxel cube's extent in depth
-  // (a sample inside a voxel's cube lies at most that far in front of its centre); the radius
-  // of the sphere around a brick.
+  // One voxel along each block axis, in the camera frame, and half the extent of a block's and
+  // a brick's cube along each camera axis.
   const float voxel_m = volume.voxel_size_m();
   const Eigen::Vector3f voxel_x = R_C_W.col(0) * voxel_m, voxel_y = R_C_W.col(1) * voxel_m,
                         voxel_z = R_C_W.col(2) * voxel_m;
-  const float cube_half_depth =
-      0.5f * (std::abs(voxel_x.z()) + std::abs(voxel_y.z()) + std::abs(voxel_z.z()));
-  const float brick_radius = 0.5f * std::sqrt(3.f) * float(kBrickSide) * voxel_m;
-  const float u_max_px = float(camera.width - 1), v_max_px = float(camera.height - 1);
+  const Eigen::Vector3f voxel_extent = voxel_x.cwiseAbs() + voxel_y.cwiseAbs() + voxel_z.cwiseAbs();
+  const Eigen::Vector3f block_half_extent = (0.5f * float(kBlockSide)) * voxel_extent;
+  const Eigen::Vector3f brick_half_extent = (0.5f * float(kBrickSide)) * voxel_extent;
 
+  // A visible block whose negative bricks are still to be splatted.
+  struct Visible {
+    const TsdfBlock* block;
+    Eigen::Vector3f p0_C;
+    float z_lo;  // the block's nearest depth, at least z_near
+  };
   ParallelFor(num_chunks, 1, [&](size_t begin, size_t end) {
+    std::vector<Visible> visible;
     for (size_t c = begin; c < end; ++c) {
       Chunk& chunk = chunks[c];
       chunk.z_min.assign(num_cells, kInf);
@@ -165,60 +185,39 @@ RangeImage BuildRangeImage(const TsdfVolume& volume, const PinholeCamera& camera
       chunk.surface_z_min.assign(num_surface_cells, kInf);
       const size_t first = blocks.size() * c / num_chunks;
       const size_t last = blocks.size() * (c + 1) / num_chunks;
+      visible.clear();
       for (size_t k = first; k < last; ++k) {
         const Eigen::Vector3f p0_C = T_C_W * BlockOrigin(blocks[k], block_m);
-        Eigen::Vector3f corner_C[8];
-        float box_z_min = kInf, box_z_max = -kInf;
-        for (int i = 0; i < 8; ++i) {
-          corner_C[i] = p0_C;
-          if (i & 1) corner_C[i] += axis_x;
-          if (i & 2) corner_C[i] += axis_y;
-          if (i & 4) corner_C[i] += axis_z;
-          box_z_min = std::min(box_z_min, corner_C[i].z());
-          box_z_max = std::max(box_z_max, corner_C[i].z());
-        }
-        if (box_z_max < z_near || box_z_min > z_far) continue;
-        // The box clipped to z >= z_near: its corners in front plus the edges' crossings.
-        float u_min = kInf, u_max = -kInf, v_min = kInf, v_max = -kInf;
-        auto add = [&](const Eigen::Vector3f& p) {
-          const float u = camera.fx * p.x() / p.z() + camera.cx;
-          const float v = camera.fy * p.y() / p.z() + camera.cy;
-          u_min = std::min(u_min, u), u_max = std::max(u_max, u);
-          v_min = std::min(v_min, v), v_max = std::max(v_max, v);
-        };
-        for (int i = 0; i < 8; ++i) {
-          if (corner_C[i].z() >= z_near) add(corner_C[i]);
-          if (box_z_min >= z_near) continue;
-          for (int bit = 1; bit < 8; bit <<= 1) {
-            if (i & bit) continue;
-            const Eigen::Vector3f& a = corner_C[i];
-            const Eigen::Vector3f& b = corner_C[i | bit];
-            if ((a.z() < z_near) == (b.z() < z_near)) continue;
-            const float t = (z_near - a.z()) / (b.z() - a.z());
-            Eigen::Vector3f p = a + t * (b - a);
-            p.z() = z_near;
-            add(p);
-          }
-        }
-        if (!(u_min <= u_max) || !(v_min <= v_max)) continue;
-        const float u_lo = std::max(std::ceil(u_min - kPixelMargin), 0.f);
-        const float u_hi = std::min(std::floor(u_max + kPixelMargin), u_max_px);
-        const float v_lo = std::max(std::ceil(v_min - kPixelMargin), 0.f);
-        const float v_hi = std::min(std::floor(v_max + kPixelMargin), v_max_px);
-        if (u_lo > u_hi || v_lo > v_hi) continue;
-        const float z_lo = std::max(box_z_min, z_near), z_hi = box_z_max;
-        for (int cy = int(v_lo) / kRangeCell; cy <= int(v_hi) / kRangeCell; ++cy)
-          for (int cx = int(u_lo) / kRangeCell; cx <= int(u_hi) / kRangeCell; ++cx) {
+        const Eigen::Vector3f centre_C = p0_C + 0.5f * (axis_x + axis_y + axis_z);
+        PixelRange pixels;
+        if (centre_C.z() - block_half_extent.z() > z_far ||
+            !ProjectBox(camera, centre_C, block_half_extent, z_near, &pixels))
+          continue;
+        const float z_lo = std::max(centre_C.z() - block_half_extent.z(), z_near);
+        const float z_hi = centre_C.z() + block_half_extent.z();
+        for (int cy = int(pixels.v_lo) / kRangeCell; cy <= int(pixels.v_hi) / kRangeCell; ++cy)
+          for (int cx = int(pixels.u_lo) / kRangeCell; cx <= int(pixels.u_hi) / kRangeCell; ++cx) {
             const size_t cell = size_t(cy) * size_t(range.cols) + size_t(cx);
             chunk.z_min[cell] = std::min(chunk.z_min[cell], z_lo);
             chunk.z_max[cell] = std::max(chunk.z_max[cell], z_hi);
           }
-        uint64_t bricks = NegativeBrickMask(*block_data[k], min_weight_fixed);
-        if (!bricks) continue;
-        // Each brick holding a negative voxel splats a lower bound of the depth of those
-        // voxels' cubes over the pixels its bounding sphere can project to (the whole block's
-        // where the sphere reaches z_near). A 2-voxel brick's voxel centres lie within one
-        // cube_half_depth of its centre in depth, and their cubes one more.
+        visible.push_back({block_data[k], p0_C, z_lo});
+      }
+      // The visible blocks' negative bricks. Blocks lie scattered over the pool, so each would
+      // wait on its distances line by line: those of a block a few places ahead are prefetched.
+      constexpr size_t kAhead = 4;
+      for (size_t j = 0; j < visible.size(); ++j) {
+        if (j + kAhead < visible.size()) {
+          const char* tsdf = reinterpret_cast<const char*>(visible[j + kAhead].block->tsdf);
+          constexpr size_t kCacheLine = 64;
+          for (size_t line = 0; line < sizeof(TsdfBlock::tsdf); line += kCacheLine)
+            __builtin_prefetch(tsdf + line);
+        }
+        const auto& [block, p0_C, z_lo] = visible[j];
+        uint64_t bricks = NegativeBrickMask(*block);
+        // Each brick holding a negative voxel splats the near depth of its cube's camera-aligned
+        // bounding box (a lower bound of those voxels' cubes) over the pixels the box can
+        // project to (the whole block's where the box reaches z_near).
         const Eigen::Vector3f brick0_C =
             p0_C + (0.5f * float(kBrickSide)) * (voxel_x + voxel_y + voxel_z);
         for (; bricks; bricks &= bricks - 1) {
@@ -228,25 +227,14 @@ RangeImage BuildRangeImage(const TsdfVolume& volume, const PinholeCamera& camera
           const Eigen::Vector3f c_C =
               brick0_C +
               float(kBrickSide) * (float(bx) * voxel_x + float(by) * voxel_y + float(bz) * voxel_z);
-          const float surface_z = std::max(c_C.z() - 2.f * cube_half_depth, z_lo);
-          float bu_lo = u_lo, bu_hi = u_hi, bv_lo = v_lo, bv_hi = v_hi;
-          const float z_front = c_C.z() - brick_radius;
-          if (z_front > z_near) {
-            // A point of the sphere projects within r (1 + |x_c / z_c|) / (z_c - r) of the
-            // centre's projection, in normalised image units.
-            const float inv_z = 1.f / c_C.z(), inv_front = 1.f / z_front;
-            const float xn = c_C.x() * inv_z, yn = c_C.y() * inv_z;
-            const float ru = std::abs(camera.fx) * brick_radius * (1.f + std::abs(xn)) * inv_front;
-            const float rv = std::abs(camera.fy) * brick_radius * (1.f + std::abs(yn)) * inv_front;
-            const float u_c = camera.fx * xn + camera.cx, v_c = camera.fy * yn + camera.cy;
-            bu_lo = std::max(std::ceil(u_c - ru - kPixelMargin), u_lo);
-            bu_hi = std::min(std::floor(u_c + ru + kPixelMargin), u_hi);
-            bv_lo = std::max(std::ceil(v_c - rv - kPixelMargin), v_lo);
-            bv_hi = std::min(std::floor(v_c + rv + kPixelMargin), v_hi);
-            if (bu_lo > bu_hi || bv_lo > bv_hi) continue;
-          }
-          for (int cy = int(bv_lo) / kSurfaceCell; cy <= int(bv_hi) / kSurfaceCell; ++cy)
-            for (int cx = int(bu_lo) / kSurfaceCell; cx <= int(bu_hi) / kSurfaceCell; ++cx) {
+          const float z_front = c_C.z() - brick_half_extent.z();
+          const float surface_z = std::max(z_front, z_lo);
+          PixelRange pixels;
+          if (!ProjectBox(camera, c_C, brick_half_extent, z_near, &pixels)) continue;
+          for (int cy = int(pixels.v_lo) / kSurfaceCell; cy <= int(pixels.v_hi) / kSurfaceCell;
+               ++cy)
+            for (int cx = int(pixels.u_lo) / kSurfaceCell; cx <= int(pixels.u_hi) / kSurfaceCell;
+                 ++cx) {
               float& z = chunk.surface_z_min[size_t(cy) * size_t(range.surface_cols) + size_t(cx)];
               z = std::min(z, surface_z);
             }

@@ -183,6 +183,43 @@ TEST(Raycast, BoxWithNegativeFy) {
   EXPECT_EQ(bad_normals, 0u);
 }
 
+TEST(Raycast, ThinSheetInFrontOfAFloorHidesIt) {
+  // Rays skip ahead to just in front of the nearest negative voxel the range image knows of;
+  // were that bound ever beyond a surface, a sheet 2.5 voxels thick would be jumped and the
+  // floor 15 cm behind it reported instead. Seen head-on, obliquely and near grazing.
+  const Box sheet{Eigen::Vector3f(-0.25f, -0.25f, 0.f), Eigen::Vector3f(0.25f, 0.25f, 0.025f)};
+  const Plane floor{Eigen::Vector3f::UnitZ(), -0.15f};
+  const TsdfVolume volume =
+      FillExact([&](const Eigen::Vector3f& p) { return std::min(sheet.Sdf(p), floor.Sdf(p)); },
+                Eigen::Vector3f(-0.6f, -0.6f, -0.2f), Eigen::Vector3f(0.6f, 0.6f, 0.1f));
+  const PinholeCamera cam = TestCamera(160, 120);
+  for (const float tilt_deg : {0.f, 35.f, 60.f, 72.f}) {
+    const float tilt = tilt_deg * float(M_PI) / 180.f, azimuth = 0.4f + tilt;
+    const Eigen::Vector3f eye =
+        0.8f * Eigen::Vector3f(std::sin(tilt) * std::cos(azimuth),
+                               std::sin(tilt) * std::sin(azimuth), std::cos(tilt));
+    const Pose3f T_W_C = LookAt(eye, Eigen::Vector3f(0.01f, 0.02f, 0.f));
+    const RaycastImages images = Raycast(volume, cam, T_W_C);
+    const DepthImage on_sheet = test::RenderDepth(sheet, cam, T_W_C);
+    // Behind: a hit past the sheet (the floor). Off: no hit or not on the sheet, allowed at a
+    // few pixels where the interpolant bends around the sheet's edges.
+    size_t checked = 0, behind = 0, off = 0;
+    for (int v = 0; v < cam.height; ++v)
+      for (int u = 0; u < cam.width; ++u) {
+        if (!Interior(on_sheet, u, v, 2)) continue;
+        ++checked;
+        const bool hit = images.status.at(u, v) == uint8_t(RayStatus::kHit);
+        const float error_m = images.depth.at(u, v) - on_sheet.at(u, v);
+        behind += hit && error_m > kVoxel;
+        off += !hit || std::abs(error_m) > kVoxel;
+      }
+    SCOPED_TRACE(tilt_deg);
+    EXPECT_GT(checked, 500u);
+    EXPECT_EQ(behind, 0u);
+    EXPECT_LE(double(off), 0.01 * double(checked));
+  }
+}
+
 // A wall at x = 0.5 seen head-on from the origin, its whole neighbourhood allocated.
 struct Wall {
   Plane plane{Eigen::Vector3f(-1.f, 0.f, 0.f), -0.5f};  // free space at x < 0.5
