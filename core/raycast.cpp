@@ -190,11 +190,10 @@ RangeImage BuildRangeImage(const TsdfVolume& volume, const PinholeCamera& camera
         const Eigen::Vector3f p0_C = T_C_W * BlockOrigin(blocks[k], block_m);
         const Eigen::Vector3f centre_C = p0_C + 0.5f * (axis_x + axis_y + axis_z);
         PixelRange pixels;
-        if (centre_C.z() - block_half_extent.z() > z_far ||
-            !ProjectBox(camera, centre_C, block_half_extent, z_near, &pixels))
+        const float z_box = centre_C.z() - block_half_extent.z();  // nearest depth of the box
+        if (z_box > z_far || !ProjectBox(camera, centre_C, block_half_extent, z_near, &pixels))
           continue;
-        const float z_lo = std::max(centre_C.z() - block_half_extent.z(), z_near);
-        const float z_hi = centre_C.z() + block_half_extent.z();
+        const float z_lo = std::max(z_box, z_near), z_hi = centre_C.z() + block_half_extent.z();
         for (int cy = int(pixels.v_lo) / kRangeCell; cy <= int(pixels.v_hi) / kRangeCell; ++cy)
           for (int cx = int(pixels.u_lo) / kRangeCell; cx <= int(pixels.u_hi) / kRangeCell; ++cx) {
             const size_t cell = size_t(cy) * size_t(range.cols) + size_t(cx);

@@ -185,8 +185,8 @@ TEST(Raycast, BoxWithNegativeFy) {
 
 TEST(Raycast, ThinSheetInFrontOfAFloorHidesIt) {
   // Rays skip ahead to just in front of the nearest negative voxel the range image knows of;
-  // were that bound ever beyond a surface, a sheet 2.5 voxels thick would be jumped and the
-  // floor 15 cm behind it reported instead. Seen head-on, obliquely and near grazing.
+  // were that bound ever past the sheet (2.5 voxels thick), the floor 15 cm behind it would be
+  // reported instead. Seen head-on, obliquely and near grazing.
   const Box sheet{Eigen::Vector3f(-0.25f, -0.25f, 0.f), Eigen::Vector3f(0.25f, 0.25f, 0.025f)};
   const Plane floor{Eigen::Vector3f::UnitZ(), -0.15f};
   const TsdfVolume volume =
