@@ -169,6 +169,10 @@ RangeImage BuildRangeImage(const TsdfVolume& volume, const PinholeCamera& camera
   const Eigen::Vector3f voxel_extent = voxel_x.cwiseAbs() + voxel_y.cwiseAbs() + voxel_z.cwiseAbs();
   const Eigen::Vector3f block_half_extent = (0.5f * float(kBlockSide)) * voxel_extent;
   const Eigen::Vector3f brick_half_extent = (0.5f * float(kBrickSide)) * voxel_extent;
+  // From a block's origin to its centre and to its first brick's centre, in the camera frame.
+  const Eigen::Vector3f to_block_centre_C = 0.5f * (axis_x + axis_y + axis_z);
+  const Eigen::Vector3f to_brick_centre_C =
+      (0.5f * float(kBrickSide)) * (voxel_x + voxel_y + voxel_z);
 
   // A visible block whose negative bricks are still to be splatted.
   struct Visible {
@@ -188,7 +192,7 @@ RangeImage BuildRangeImage(const TsdfVolume& volume, const PinholeCamera& camera
       visible.clear();
       for (size_t k = first; k < last; ++k) {
         const Eigen::Vector3f p0_C = T_C_W * BlockOrigin(blocks[k], block_m);
-        const Eigen::Vector3f centre_C = p0_C + 0.5f * (axis_x + axis_y + axis_z);
+        const Eigen::Vector3f centre_C = p0_C + to_block_centre_C;
         PixelRange pixels;
         const float z_box = centre_C.z() - block_half_extent.z();  // nearest depth of the box
         if (z_box > z_far || !ProjectBox(camera, centre_C, block_half_extent, z_near, &pixels))
@@ -217,8 +221,7 @@ RangeImage BuildRangeImage(const TsdfVolume& volume, const PinholeCamera& camera
         // Each brick holding a negative voxel splats the near depth of its cube's camera-aligned
         // bounding box (a lower bound of those voxels' cubes) over the pixels the box can
         // project to (the whole block's where the box reaches z_near).
-        const Eigen::Vector3f brick0_C =
-            p0_C + (0.5f * float(kBrickSide)) * (voxel_x + voxel_y + voxel_z);
+        const Eigen::Vector3f brick0_C = p0_C + to_brick_centre_C;
         for (; bricks; bricks &= bricks - 1) {
           const int i = std::countr_zero(bricks);
           const int bx = i % kBricksPerSide, by = (i / kBricksPerSide) % kBricksPerSide,

@@ -120,9 +120,8 @@ constexpr BlockIndex FromOrderedKey(uint64_t k) {
           int32_t(k >> 42) - kKeyOffset};
 }
 
-// Sorted runs of keys in (one per task, without duplicates), sorted blocks out. The runs are
-// few (about a few per thread) and their tasks already sorted them, so merging them pairwise
-// here is cheaper than waking the threads again.
+// Sorted runs of keys in (one per task, without duplicates), sorted blocks out. Their tasks
+// already sorted them, so they are merged pairwise, the pairs of a round in parallel.
 std::vector<BlockIndex> MergeToSortedBlocks(std::vector<std::vector<uint64_t>>& runs) {
   while (runs.size() > 1) {
     std::vector<std::vector<uint64_t>> merged((runs.size() + 1) / 2);
