@@ -73,7 +73,7 @@ static_assert(kBricks == 64);
 // Fresh voxels are +1, so a negative one has been observed; its weight is not read (half the
 // bytes): under a raised RaycastParams::min_weight the mask only grows, which keeps the bound it
 // feeds a bound. Depends on the block only, not the camera; a compare and a movemask per x-row.
-uint64_t NegativeBrickMask(const TsdfBlock& block) {
+[[gnu::always_inline]] inline uint64_t NegativeBrickMask(const TsdfBlock& block) {
   uint64_t mask = 0;
   for (int row = 0; row < kBlockSide * kBlockSide; ++row) {
     const int16_t* tsdf = block.tsdf + row * kBlockSide;
@@ -111,8 +111,10 @@ struct PixelRange {
 // The pixels that the part at z >= z_near of the camera-aligned box centre_C +- half_extent
 // can project to, half a pixel beyond to absorb rounding; false when none can. Over the box,
 // x / z is largest at the near face where x > 0 and at the far face otherwise (so for y).
-bool ProjectBox(const PinholeCamera& camera, const Eigen::Vector3f& centre_C,
-                const Eigen::Vector3f& half_extent, float z_near, PixelRange* pixels) {
+[[gnu::always_inline]] inline bool ProjectBox(const PinholeCamera& camera,
+                                              const Eigen::Vector3f& centre_C,
+                                              const Eigen::Vector3f& half_extent, float z_near,
+                                              PixelRange* pixels) {
   const float z_front = std::max(centre_C.z() - half_extent.z(), z_near);
   const float z_back = centre_C.z() + half_extent.z();
   if (!(z_front <= z_back)) return false;
@@ -131,6 +133,124 @@ bool ProjectBox(const PinholeCamera& camera, const Eigen::Vector3f& centre_C,
          range(centre_C.y(), half_extent.y(), camera.fy, camera.cy, camera.height, &pixels->v_lo,
                &pixels->v_hi);
 }
+
+// Floats a chunk's surface image holds beyond its last cell, for MinRow.
+constexpr size_t kSurfaceRowPad = 3;
+
+// row[x] = min(row[x], z) for x in [lo, hi]. A brick covers a few cells of a row, so four are
+// taken at a time (those outside the range keep their value); row[hi + 3] must exist.
+[[gnu::always_inline]] inline void MinRow(float* row, int lo, int hi, float z) {
+#if defined(__SSE2__)
+  const __m128 zs = _mm_set1_ps(z);
+  for (int x = lo; x <= hi; x += 4) {
+    const __m128i lane = _mm_add_epi32(_mm_set1_epi32(x), _mm_set_epi32(3, 2, 1, 0));
+    const __m128 in_range = _mm_castsi128_ps(_mm_cmplt_epi32(lane, _mm_set1_epi32(hi + 1)));
+    const __m128 old = _mm_loadu_ps(row + x);
+    _mm_storeu_ps(row + x, _mm_or_ps(_mm_and_ps(in_range, _mm_min_ps(old, zs)),
+                                     _mm_andnot_ps(in_range, old)));
+  }
+#else
+  for (int x = lo; x <= hi; ++x) row[x] = std::min(row[x], z);
+#endif
+}
+
+// What splatting blocks into a range image needs for one cast: the camera, the pose and the
+// block and brick geometry in the camera frame.
+struct Splatter {
+  const PinholeCamera& camera;
+  Pose3f T_C_W;
+  float block_m, z_near, z_far;
+  int cols, surface_cols;
+  size_t num_cells, num_surface_cells;
+  // One voxel along each block axis, in the camera frame; half the extent of a block's and a
+  // brick's cube along each camera axis; from a block's origin to its centre and to its first
+  // brick's centre.
+  Eigen::Vector3f voxel_x, voxel_y, voxel_z, block_half_extent, brick_half_extent,
+      to_block_centre_C, to_brick_centre_C;
+
+  // A visible block whose negative bricks are still to be splatted.
+  struct Visible {
+    const TsdfBlock* block;
+    Eigen::Vector3f p0_C;
+    float z_lo;  // the block's nearest depth, at least z_near
+  };
+
+  // Splats blocks [first, last) into `chunk`; `visible` is scratch space.
+  [[gnu::always_inline]] inline void Run(const BlockIndex* blocks, const TsdfBlock* const* data,
+                                         size_t first, size_t last, Chunk& chunk,
+                                         std::vector<Visible>& visible) const {
+    constexpr float kInf = std::numeric_limits<float>::infinity();
+    chunk.z_min.assign(num_cells, kInf);
+    chunk.z_max.assign(num_cells, -kInf);
+    // Padded so that a row of cells is updated four at a time (see below).
+    chunk.surface_z_min.assign(num_surface_cells + kSurfaceRowPad, kInf);
+    visible.clear();
+    for (size_t k = first; k < last; ++k) {
+      const Eigen::Vector3f p0_C = T_C_W * BlockOrigin(blocks[k], block_m);
+      const Eigen::Vector3f centre_C = p0_C + to_block_centre_C;
+      PixelRange pixels;
+      const float z_box = centre_C.z() - block_half_extent.z();  // nearest depth of the box
+      if (z_box > z_far || !ProjectBox(camera, centre_C, block_half_extent, z_near, &pixels))
+        continue;
+      const float z_lo = std::max(z_box, z_near), z_hi = centre_C.z() + block_half_extent.z();
+      for (int cy = int(pixels.v_lo) / kRangeCell; cy <= int(pixels.v_hi) / kRangeCell; ++cy)
+        for (int cx = int(pixels.u_lo) / kRangeCell; cx <= int(pixels.u_hi) / kRangeCell; ++cx) {
+          const size_t cell = size_t(cy) * size_t(cols) + size_t(cx);
+          chunk.z_min[cell] = std::min(chunk.z_min[cell], z_lo);
+          chunk.z_max[cell] = std::max(chunk.z_max[cell], z_hi);
+        }
+      visible.push_back({data[k], p0_C, z_lo});
+    }
+    // The visible blocks' negative bricks. Blocks lie scattered over the pool, so each would
+    // wait on its distances line by line: those of a block a few places ahead are prefetched.
+    constexpr size_t kAhead = 4;
+    for (size_t j = 0; j < visible.size(); ++j) {
+      if (j + kAhead < visible.size()) {
+        const char* tsdf = reinterpret_cast<const char*>(visible[j + kAhead].block->tsdf);
+        constexpr size_t kCacheLine = 64;
+        for (size_t line = 0; line < sizeof(TsdfBlock::tsdf); line += kCacheLine)
+          __builtin_prefetch(tsdf + line);
+      }
+      const auto& [block, p0_C, z_lo] = visible[j];
+      uint64_t bricks = NegativeBrickMask(*block);
+      // Each brick holding a negative voxel splats the near depth of its cube's camera-aligned
+      // bounding box (a lower bound of those voxels' cubes) over the pixels the box can
+      // project to (the whole block's where the box reaches z_near).
+      const Eigen::Vector3f brick0_C = p0_C + to_brick_centre_C;
+      for (; bricks; bricks &= bricks - 1) {
+        const int i = std::countr_zero(bricks);
+        const int bx = i % kBricksPerSide, by = (i / kBricksPerSide) % kBricksPerSide,
+                  bz = i / (kBricksPerSide * kBricksPerSide);
+        const Eigen::Vector3f c_C =
+            brick0_C +
+            float(kBrickSide) * (float(bx) * voxel_x + float(by) * voxel_y + float(bz) * voxel_z);
+        const float z_front = c_C.z() - brick_half_extent.z();
+        const float surface_z = std::max(z_front, z_lo);
+        PixelRange pixels;
+        if (!ProjectBox(camera, c_C, brick_half_extent, z_near, &pixels)) continue;
+        const int cx_lo = int(pixels.u_lo) / kSurfaceCell, cx_hi = int(pixels.u_hi) / kSurfaceCell;
+        for (int cy = int(pixels.v_lo) / kSurfaceCell; cy <= int(pixels.v_hi) / kSurfaceCell; ++cy)
+          MinRow(chunk.surface_z_min.data() + size_t(cy) * size_t(surface_cols), cx_lo, cx_hi,
+                 surface_z);
+      }
+    }
+  }
+};
+
+void SplatChunk(const Splatter& splatter, const BlockIndex* blocks, const TsdfBlock* const* data,
+                size_t first, size_t last, Chunk& chunk, std::vector<Splatter::Visible>& visible) {
+  splatter.Run(blocks, data, first, last, chunk, visible);
+}
+
+#if VOXPLAN_RAYCAST_AVX2
+// The same code for AVX2 CPUs, where std::ceil and std::floor are one instruction (SSE4.1's
+// round) instead of a dozen; the results are the same.
+VOXPLAN_TARGET_AVX2 void SplatChunkAvx2(const Splatter& splatter, const BlockIndex* blocks,
+                                        const TsdfBlock* const* data, size_t first, size_t last,
+                                        Chunk& chunk, std::vector<Splatter::Visible>& visible) {
+  splatter.Run(blocks, data, first, last, chunk, visible);
+}
+#endif
 
 RangeImage BuildRangeImage(const TsdfVolume& volume, const PinholeCamera& camera,
                            const Pose3f& T_C_W, const RaycastParams& params) {
@@ -156,92 +276,44 @@ RangeImage BuildRangeImage(const TsdfVolume& volume, const PinholeCamera& camera
   constexpr size_t kBlocksPerChunk = 1024;
   const size_t num_chunks = std::clamp<size_t>(blocks.size() / kBlocksPerChunk, 1, 16);
   std::vector<Chunk> chunks(num_chunks);
-  const float block_m = volume.block_size_m();
-  const Eigen::Matrix3f R_C_W = T_C_W.linear();
-  const Eigen::Vector3f axis_x = R_C_W.col(0) * block_m, axis_y = R_C_W.col(1) * block_m,
-                        axis_z = R_C_W.col(2) * block_m;
-  const float z_near = MarchStart(volume, params), z_far = params.max_depth_m;
-  // One voxel along each block axis, in the camera frame, and half the extent of a block's and
-  // a brick's cube along each camera axis.
   const float voxel_m = volume.voxel_size_m();
+  const Eigen::Matrix3f R_C_W = T_C_W.linear();
   const Eigen::Vector3f voxel_x = R_C_W.col(0) * voxel_m, voxel_y = R_C_W.col(1) * voxel_m,
                         voxel_z = R_C_W.col(2) * voxel_m;
   const Eigen::Vector3f voxel_extent = voxel_x.cwiseAbs() + voxel_y.cwiseAbs() + voxel_z.cwiseAbs();
-  const Eigen::Vector3f block_half_extent = (0.5f * float(kBlockSide)) * voxel_extent;
-  const Eigen::Vector3f brick_half_extent = (0.5f * float(kBrickSide)) * voxel_extent;
-  // From a block's origin to its centre and to its first brick's centre, in the camera frame.
-  const Eigen::Vector3f to_block_centre_C = 0.5f * (axis_x + axis_y + axis_z);
-  const Eigen::Vector3f to_brick_centre_C =
-      (0.5f * float(kBrickSide)) * (voxel_x + voxel_y + voxel_z);
-
-  // A visible block whose negative bricks are still to be splatted.
-  struct Visible {
-    const TsdfBlock* block;
-    Eigen::Vector3f p0_C;
-    float z_lo;  // the block's nearest depth, at least z_near
-  };
+  const float block_m = volume.block_size_m();
+  const Splatter splatter{
+      camera,
+      T_C_W,
+      block_m,
+      MarchStart(volume, params),
+      params.max_depth_m,
+      range.cols,
+      range.surface_cols,
+      num_cells,
+      num_surface_cells,
+      voxel_x,
+      voxel_y,
+      voxel_z,
+      (0.5f * float(kBlockSide)) * voxel_extent,
+      (0.5f * float(kBrickSide)) * voxel_extent,
+      0.5f * (R_C_W.col(0) * block_m + R_C_W.col(1) * block_m + R_C_W.col(2) * block_m),
+      (0.5f * float(kBrickSide)) * (voxel_x + voxel_y + voxel_z)};
+#if VOXPLAN_RAYCAST_AVX2
+  const bool avx2 = params.simd && RaycastSimdAvailable();
+#endif
   ParallelFor(num_chunks, 1, [&](size_t begin, size_t end) {
-    std::vector<Visible> visible;
+    std::vector<Splatter::Visible> visible;
     for (size_t c = begin; c < end; ++c) {
-      Chunk& chunk = chunks[c];
-      chunk.z_min.assign(num_cells, kInf);
-      chunk.z_max.assign(num_cells, -kInf);
-      chunk.surface_z_min.assign(num_surface_cells, kInf);
       const size_t first = blocks.size() * c / num_chunks;
       const size_t last = blocks.size() * (c + 1) / num_chunks;
-      visible.clear();
-      for (size_t k = first; k < last; ++k) {
-        const Eigen::Vector3f p0_C = T_C_W * BlockOrigin(blocks[k], block_m);
-        const Eigen::Vector3f centre_C = p0_C + to_block_centre_C;
-        PixelRange pixels;
-        const float z_box = centre_C.z() - block_half_extent.z();  // nearest depth of the box
-        if (z_box > z_far || !ProjectBox(camera, centre_C, block_half_extent, z_near, &pixels))
-          continue;
-        const float z_lo = std::max(z_box, z_near), z_hi = centre_C.z() + block_half_extent.z();
-        for (int cy = int(pixels.v_lo) / kRangeCell; cy <= int(pixels.v_hi) / kRangeCell; ++cy)
-          for (int cx = int(pixels.u_lo) / kRangeCell; cx <= int(pixels.u_hi) / kRangeCell; ++cx) {
-            const size_t cell = size_t(cy) * size_t(range.cols) + size_t(cx);
-            chunk.z_min[cell] = std::min(chunk.z_min[cell], z_lo);
-            chunk.z_max[cell] = std::max(chunk.z_max[cell], z_hi);
-          }
-        visible.push_back({block_data[k], p0_C, z_lo});
+#if VOXPLAN_RAYCAST_AVX2
+      if (avx2) {
+        SplatChunkAvx2(splatter, blocks.data(), block_data.data(), first, last, chunks[c], visible);
+        continue;
       }
-      // The visible blocks' negative bricks. Blocks lie scattered over the pool, so each would
-      // wait on its distances line by line: those of a block a few places ahead are prefetched.
-      constexpr size_t kAhead = 4;
-      for (size_t j = 0; j < visible.size(); ++j) {
-        if (j + kAhead < visible.size()) {
-          const char* tsdf = reinterpret_cast<const char*>(visible[j + kAhead].block->tsdf);
-          constexpr size_t kCacheLine = 64;
-          for (size_t line = 0; line < sizeof(TsdfBlock::tsdf); line += kCacheLine)
-            __builtin_prefetch(tsdf + line);
-        }
-        const auto& [block, p0_C, z_lo] = visible[j];
-        uint64_t bricks = NegativeBrickMask(*block);
-        // Each brick holding a negative voxel splats the near depth of its cube's camera-aligned
-        // bounding box (a lower bound of those voxels' cubes) over the pixels the box can
-        // project to (the whole block's where the box reaches z_near).
-        const Eigen::Vector3f brick0_C = p0_C + to_brick_centre_C;
-        for (; bricks; bricks &= bricks - 1) {
-          const int i = std::countr_zero(bricks);
-          const int bx = i % kBricksPerSide, by = (i / kBricksPerSide) % kBricksPerSide,
-                    bz = i / (kBricksPerSide * kBricksPerSide);
-          const Eigen::Vector3f c_C =
-              brick0_C +
-              float(kBrickSide) * (float(bx) * voxel_x + float(by) * voxel_y + float(bz) * voxel_z);
-          const float z_front = c_C.z() - brick_half_extent.z();
-          const float surface_z = std::max(z_front, z_lo);
-          PixelRange pixels;
-          if (!ProjectBox(camera, c_C, brick_half_extent, z_near, &pixels)) continue;
-          for (int cy = int(pixels.v_lo) / kSurfaceCell; cy <= int(pixels.v_hi) / kSurfaceCell;
-               ++cy)
-            for (int cx = int(pixels.u_lo) / kSurfaceCell; cx <= int(pixels.u_hi) / kSurfaceCell;
-                 ++cx) {
-              float& z = chunk.surface_z_min[size_t(cy) * size_t(range.surface_cols) + size_t(cx)];
-              z = std::min(z, surface_z);
-            }
-        }
-      }
+#endif
+      SplatChunk(splatter, blocks.data(), block_data.data(), first, last, chunks[c], visible);
     }
   });
 
