@@ -471,34 +471,40 @@ class Sampler {
     const BlockIndex b0 = BlockOf(g);
     unsigned observed = cell->observed;  // set by Gather in one block
     if (!(local.x < kBlockMask && local.y < kBlockMask && local.z < kBlockMask)) {
-      // Corners across block faces: look up only the neighbours they reach (two usually).
-      observed = 0;
+      // Corners across block faces: look up only the neighbours they reach (two usually);
+      // corner k lies in neighbour k & across, a missing block reads as never observed.
       const bool ex = local.x == kBlockMask, ey = local.y == kBlockMask, ez = local.z == kBlockMask;
-      const TsdfBlock* neighbour[8] = {};
-      neighbour[0] = Find(b0);
-      if (ex) neighbour[1] = Find(BlockIndex{b0.x + 1, b0.y, b0.z});
-      if (ey) neighbour[2] = Find(BlockIndex{b0.x, b0.y + 1, b0.z});
-      if (ex && ey) neighbour[3] = Find(BlockIndex{b0.x + 1, b0.y + 1, b0.z});
+      const int across = int(ex) | int(ey) << 1 | int(ez) << 2;
+      const TsdfBlock* neighbour[8];
+      // The neighbours bypass the last-block shortcut, which keeps b0 for the next gather.
+      auto find = [&](int dx, int dy, int dz) {
+        const TsdfBlock* block = cache_.Find(BlockIndex{b0.x + dx, b0.y + dy, b0.z + dz});
+        return block ? block : &kNoBlock;
+      };
+      const TsdfBlock* block0 = Find(b0);
+      neighbour[0] = block0 ? block0 : &kNoBlock;
+      if (ex) neighbour[1] = find(1, 0, 0);
+      if (ey) neighbour[2] = find(0, 1, 0);
+      if (ex && ey) neighbour[3] = find(1, 1, 0);
       if (ez) {
-        neighbour[4] = Find(BlockIndex{b0.x, b0.y, b0.z + 1});
-        if (ex) neighbour[5] = Find(BlockIndex{b0.x + 1, b0.y, b0.z + 1});
-        if (ey) neighbour[6] = Find(BlockIndex{b0.x, b0.y + 1, b0.z + 1});
-        if (ex && ey) neighbour[7] = Find(BlockIndex{b0.x + 1, b0.y + 1, b0.z + 1});
+        neighbour[4] = find(0, 0, 1);
+        if (ex) neighbour[5] = find(1, 0, 1);
+        if (ey) neighbour[6] = find(0, 1, 1);
+        if (ex && ey) neighbour[7] = find(1, 1, 1);
       }
+      // One voxel further along each axis: the next voxel in the block, or the first one of
+      // the neighbour (wrapped).
+      const int step_x = ex ? 1 - kBlockSide : 1;
+      const int step_y = (ey ? 1 - kBlockSide : 1) * kBlockSide;
+      const int step_z = (ez ? 1 - kBlockSide : 1) * kBlockSide * kBlockSide;
+      const int i0 = LinearIndex(local);
       cell->one_block = false;
       for (int k = 0; k < 8; ++k) {
-        const int cx = k & 1, cy = (k >> 1) & 1, cz = k >> 2;
-        const TsdfBlock* block =
-            neighbour[(cx & int(ex)) | ((cy & int(ey)) << 1) | ((cz & int(ez)) << 2)];
-        const int i = LinearIndex((local.x + cx) & kBlockMask, (local.y + cy) & kBlockMask,
-                                  (local.z + cz) & kBlockMask);
-        cell->block[k] = block;
-        cell->index[k] = i;
-        if (block && Observed(*block, i)) {
-          cell->tsdf[k] = DecodeTsdf(block->tsdf[i]);
-          observed |= 1u << k;
-        }
+        cell->block[k] = neighbour[k & across];
+        cell->index[k] = i0 + (k & 1 ? step_x : 0) + (k & 2 ? step_y : 0) + (k & 4 ? step_z : 0);
       }
+      observed = raycast_detail::LoadCornersAcross(cell->block, cell->index, min_weight_fixed_,
+                                                   cell->tsdf);
     }
     cell->observed = uint8_t(observed);
     if (cell->complete()) return true;

@@ -45,6 +45,17 @@ inline uint8_t LoadCornersScalar(const TsdfBlock& block, int i0, uint32_t min_we
   return uint8_t(observed);
 }
 
+// The same for a cell across block faces: corner k is voxel index[k] of *block[k].
+inline uint8_t LoadCornersAcrossScalar(const TsdfBlock* const block[8], const int index[8],
+                                       uint32_t min_weight_fixed, float tsdf[8]) {
+  unsigned observed = 0;
+  for (int k = 0; k < 8; ++k) {
+    observed |= unsigned(uint32_t(block[k]->weight[index[k]]) >= min_weight_fixed) << k;
+    tsdf[k] = DecodeTsdf(block[k]->tsdf[index[k]]);
+  }
+  return uint8_t(observed);
+}
+
 #if VOXPLAN_RAYCAST_SSE2
 // The four x-pairs of 16-bit values of a cell, in corner order: (y, z) = (0,0) (1,0) (0,1) (1,1).
 inline __m128i LoadPairs16(const void* base, int i0) {
@@ -58,16 +69,14 @@ inline __m128i LoadPairs16(const void* base, int i0) {
                        pair(0));
 }
 
-inline uint8_t LoadCornersSse2(const TsdfBlock& block, int i0, uint32_t min_weight_fixed,
-                               float tsdf[8]) {
-  // Unsigned weight >= min as a signed compare: flip the sign bits of both sides. A minimum
-  // above 65535 is never met.
-  if (min_weight_fixed > 65535u) return LoadCornersScalar(block, i0, min_weight_fixed, tsdf);
+// Eight corners' weights and distances, 16 bits each in corner order, decoded as
+// LoadCornersScalar does; min_weight_fixed at most 65535.
+inline uint8_t DecodeCornersSse2(__m128i weight, __m128i t, uint32_t min_weight_fixed,
+                                 float tsdf[8]) {
+  // Unsigned weight >= min as a signed compare: flip the sign bits of both sides.
   const __m128i flip = _mm_set1_epi16(int16_t(0x8000));
   const __m128i min_minus_one = _mm_set1_epi16(int16_t((min_weight_fixed - 1) ^ 0x8000u));
-  const __m128i w = _mm_xor_si128(LoadPairs16(block.weight, i0), flip);
-  const __m128i observed = _mm_cmpgt_epi16(w, min_minus_one);
-  const __m128i t = LoadPairs16(block.tsdf, i0);
+  const __m128i observed = _mm_cmpgt_epi16(_mm_xor_si128(weight, flip), min_minus_one);
   // Sign-extend to 32 bits: the value in the high half, then an arithmetic shift.
   const __m128i lo = _mm_srai_epi32(_mm_unpacklo_epi16(t, t), 16);
   const __m128i hi = _mm_srai_epi32(_mm_unpackhi_epi16(t, t), 16);
@@ -75,6 +84,29 @@ inline uint8_t LoadCornersSse2(const TsdfBlock& block, int i0, uint32_t min_weig
   _mm_storeu_ps(tsdf, _mm_mul_ps(_mm_cvtepi32_ps(lo), scale));
   _mm_storeu_ps(tsdf + 4, _mm_mul_ps(_mm_cvtepi32_ps(hi), scale));
   return uint8_t(_mm_movemask_epi8(_mm_packs_epi16(observed, _mm_setzero_si128())));
+}
+
+inline uint8_t LoadCornersSse2(const TsdfBlock& block, int i0, uint32_t min_weight_fixed,
+                               float tsdf[8]) {
+  // A minimum above 65535 is never met.
+  if (min_weight_fixed > 65535u) return LoadCornersScalar(block, i0, min_weight_fixed, tsdf);
+  return DecodeCornersSse2(LoadPairs16(block.weight, i0), LoadPairs16(block.tsdf, i0),
+                           min_weight_fixed, tsdf);
+}
+
+inline uint8_t LoadCornersAcrossSse2(const TsdfBlock* const block[8], const int index[8],
+                                     uint32_t min_weight_fixed, float tsdf[8]) {
+  if (min_weight_fixed > 65535u)
+    return LoadCornersAcrossScalar(block, index, min_weight_fixed, tsdf);
+  auto gather = [&](auto field) {
+    return _mm_setr_epi16(
+        int16_t((block[0]->*field)[index[0]]), int16_t((block[1]->*field)[index[1]]),
+        int16_t((block[2]->*field)[index[2]]), int16_t((block[3]->*field)[index[3]]),
+        int16_t((block[4]->*field)[index[4]]), int16_t((block[5]->*field)[index[5]]),
+        int16_t((block[6]->*field)[index[6]]), int16_t((block[7]->*field)[index[7]]));
+  };
+  return DecodeCornersSse2(gather(&TsdfBlock::weight), gather(&TsdfBlock::tsdf), min_weight_fixed,
+                           tsdf);
 }
 #endif
 
@@ -84,6 +116,15 @@ inline uint8_t LoadCorners(const TsdfBlock& block, int i0, uint32_t min_weight_f
   return LoadCornersSse2(block, i0, min_weight_fixed, tsdf);
 #else
   return LoadCornersScalar(block, i0, min_weight_fixed, tsdf);
+#endif
+}
+
+inline uint8_t LoadCornersAcross(const TsdfBlock* const block[8], const int index[8],
+                                 uint32_t min_weight_fixed, float tsdf[8]) {
+#if VOXPLAN_RAYCAST_SSE2
+  return LoadCornersAcrossSse2(block, index, min_weight_fixed, tsdf);
+#else
+  return LoadCornersAcrossScalar(block, index, min_weight_fixed, tsdf);
 #endif
 }
 

@@ -500,6 +500,30 @@ TEST(RaycastKernels, CornerLoadsMatchTheScalarReferenceExactly) {
 #endif
 }
 
+TEST(RaycastKernels, CornerLoadsAcrossBlocksMatchTheScalarReferenceExactly) {
+#if !VOXPLAN_RAYCAST_SSE2
+  GTEST_SKIP() << "no SSE2 kernels in this build";
+#else
+  std::mt19937 rng(11);
+  const TsdfBlock blocks[3] = {RandomBlock(rng), RandomBlock(rng), RandomBlock(rng)};
+  std::uniform_int_distribution<int> which(0, 2), voxel(0, kBlockVoxels - 1);
+  for (const uint32_t min_weight : {1u, 64u, 32768u, 65535u, 65536u})
+    for (int trial = 0; trial < 500; ++trial) {
+      const TsdfBlock* block[8];
+      int index[8];
+      for (int k = 0; k < 8; ++k) block[k] = &blocks[which(rng)], index[k] = voxel(rng);
+      float scalar[8], simd[8];
+      const uint8_t observed = kernels::LoadCornersAcrossScalar(block, index, min_weight, scalar);
+      ASSERT_EQ(kernels::LoadCornersAcrossSse2(block, index, min_weight, simd), observed);
+      for (int k = 0; k < 8; ++k) {
+        ASSERT_EQ(simd[k], scalar[k]) << "corner " << k;
+        EXPECT_EQ(scalar[k], DecodeTsdf(block[k]->tsdf[index[k]]));
+        EXPECT_EQ(bool(observed & (1 << k)), block[k]->weight[index[k]] >= min_weight);
+      }
+    }
+#endif
+}
+
 // Rounding of 4-term sums of values in [-1, 1] taken in another order.
 constexpr float kSumRounding = 1e-6f;
 
