@@ -89,8 +89,43 @@ Status FloorMap::Rebuild(const TsdfVolume& volume) {
   cells_.clear();
   const std::vector<BlockIndex> blocks = volume.SortedBlockIndices();
   VOXPLAN_RETURN_IF_ERROR(Update(volume, blocks));
+  ApplyMarks({marked_.begin(), marked_.end()});  // also those in columns without blocks
   revision_ = NextRevision();  // the extent may have shrunk, which Update never reports
   return Status::Ok();
+}
+
+bool FloorMap::MarkObstacles(std::span<const Eigen::Vector2f> points_W) {
+  std::vector<std::pair<int, int>> added;
+  for (const Eigen::Vector2f& p : points_W) {
+    if (!p.allFinite()) continue;
+    const std::pair<int, int> c = {FloorToInt(p.x() / geometry_.cell_size_m),
+                                   FloorToInt(p.y() / geometry_.cell_size_m)};
+    if (marked_.insert(c).second) added.push_back(c);
+  }
+  if (added.empty()) return false;
+  const bool changed = ApplyMarks(added);
+  if (changed) revision_ = NextRevision();
+  return changed;
+}
+
+bool FloorMap::ApplyMarks(const std::vector<std::pair<int, int>>& cells) {
+  if (cells.empty()) return false;
+  const int cpb = kBlockSide / params_.cell_voxels;
+  const auto floor_div = [cpb](int v) { return v >= 0 ? v / cpb : -((-v + cpb - 1) / cpb); };
+  std::vector<Eigen::Vector2i> columns;
+  for (const auto& [x, y] : cells) columns.emplace_back(floor_div(x), floor_div(y));
+  std::sort(columns.begin(), columns.end(), [](const Eigen::Vector2i& a, const Eigen::Vector2i& b) {
+    return a.y() != b.y() ? a.y() < b.y() : a.x() < b.x();
+  });
+  columns.erase(std::unique(columns.begin(), columns.end()), columns.end());
+  bool changed = GrowToCover(columns);
+  for (const auto& [x, y] : cells) {
+    FloorCell& cell =
+        cells_[geometry_.Linear(x - geometry_.origin_cell.x(), y - geometry_.origin_cell.y())];
+    changed |= cell != FloorCell::kObstacle;
+    cell = FloorCell::kObstacle;
+  }
+  return UpdateFrontier(columns) || changed;
 }
 
 bool FloorMap::GrowToCover(const std::vector<Eigen::Vector2i>& block_columns) {
@@ -155,7 +190,9 @@ bool FloorMap::ProjectBlockColumn(const TsdfVolume& volume, Eigen::Vector2i bloc
           free += free_count[vx + kBlockSide * vy];
           occ |= occupied[vx + kBlockSide * vy] != 0;
         }
-      const FloorCell cell = occ                      ? FloorCell::kObstacle
+      const Eigen::Vector2i global = block_column * cpb + Eigen::Vector2i(cx, cy);
+      const bool marked = !marked_.empty() && marked_.count({global.x(), global.y()}) != 0;
+      const FloorCell cell = occ || marked            ? FloorCell::kObstacle
                              : free >= required_free_ ? FloorCell::kFree
                                                       : FloorCell::kUnknown;
       FloorCell& stored = cells_[geometry_.Linear(first.x() + cx, first.y() + cy)];

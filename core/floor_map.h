@@ -13,7 +13,9 @@
 // The floor itself is not checked (a planar world without stairs or holes, as in Dong 2019).
 #include <Eigen/Core>
 #include <cstdint>
+#include <set>
 #include <span>
+#include <utility>
 #include <vector>
 
 #include "core/image.h"
@@ -74,8 +76,12 @@ class FloorMap {
   // blocks ever passed, never on the thread count; it equals Rebuild() as long as every block
   // changed since was passed. InvalidArgument when the volume's voxel size differs.
   Status Update(const TsdfVolume& volume, std::span<const BlockIndex> touched_blocks);
-  // Forgets everything and projects every block of the volume.
+  // Forgets everything but the marked obstacles and projects every block of the volume.
   Status Rebuild(const TsdfVolume& volume);
+  // The cells holding these points (world xy) are obstacles from now on, whatever the volume
+  // says: what a robot's bumper ran into, which its camera may never see (too low, or in the
+  // blind zone in front of it). Grows the raster to cover them; true when a cell changed.
+  bool MarkObstacles(std::span<const Eigen::Vector2f> points_W);
 
   const FloorMapParams& params() const { return params_; }
   const FloorGeometry& geometry() const { return geometry_; }
@@ -102,6 +108,8 @@ class FloorMap {
   bool GrowToCover(const std::vector<Eigen::Vector2i>& block_columns);
   bool ProjectBlockColumn(const TsdfVolume& volume, Eigen::Vector2i block_column, float trunc_vox);
   bool UpdateFrontier(const std::vector<Eigen::Vector2i>& block_columns);
+  // Sets the marked global cells to obstacle (growing the raster), then their frontier rings.
+  bool ApplyMarks(const std::vector<std::pair<int, int>>& cells);
 
   float voxel_size_m_;
   FloorMapParams params_;
@@ -109,6 +117,7 @@ class FloorMap {
   int required_free_ = 0;          // observed-free band voxels a cell needs
   FloorGeometry geometry_;
   std::vector<FloorCell> cells_;
+  std::set<std::pair<int, int>> marked_;  // global cells (x, y) of MarkObstacles
   uint64_t revision_ = 0;
 };
 

@@ -96,6 +96,7 @@ class Explorer {
   Status StepToView(RobotRun& r, QueuedTask& q);
   bool RouteTo(RobotRun& r, const QueuedTask& q);
   void Fail(RobotRun& r, const std::string& why);
+  void Bump(RobotRun& r, const Eigen::Vector2f& goal_W);
   Status UpdateFloor();
   std::vector<PlannerRobot> Snapshot() const;
   void CallPlanner(PlanEvent event, int32_t event_robot, const PlannerTask& failed);
@@ -219,6 +220,20 @@ void Explorer::Fail(RobotRun& r, const std::string& why) {
   r.queue.pop_front();
   r.routed = false;
   r.route.clear();
+}
+
+// The bumper: what a refused drive on the host's route ran into goes on the floor map as
+// obstacle, so the host's routes and the planner's raster avoid it. Without it a robot whose camera
+// never sees the obstacle (too low, or too close) is routed into it again and again.
+void Explorer::Bump(RobotRun& r, const Eigen::Vector2f& goal_W) {
+  const Robot& robot = r.robot;
+  const std::vector<Eigen::Vector2f> contact =
+      FirstContact(robot.plan(), robot.state().position_W, goal_W, robot.params().radius_m);
+  if (!floor_->MarkObstacles(contact)) return;
+  result_.plan_log.push_back("t=" + Fmt(r.t_s) + " robot " + std::to_string(r.index) +
+                             " bumped into " + std::to_string(contact.size()) +
+                             " floor cells near (" + Fmt(contact.front().x()) + ", " +
+                             Fmt(contact.front().y()) + "): marked as obstacles");
 }
 
 // Straight shortcuts over the known raster: from each kept point, the farthest later point in
@@ -397,6 +412,10 @@ Status Explorer::Advance(RobotRun& r, double t_end_s) {
         r.routed = false;
         continue;
       }
+      // The host's own route, over the known map with its margin, ran into something the map
+      // lacks. (A plugin path that grazes a known wall, as above, teaches nothing: the grids
+      // of the map and the true plan are offset, and marking there narrows doorways.)
+      Bump(r, goal);
       Fail(r, st.message());
       continue;
     }

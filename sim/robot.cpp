@@ -84,8 +84,13 @@ PinholeCamera CameraWithFov(int width, int height, float horizontal_fov_deg) {
   return {width, height, f, f, 0.5f * float(width - 1), 0.5f * float(height - 1)};
 }
 
-bool FootprintFree(const FloorPlan& plan, const Eigen::Vector2f& p_W, float radius_m) {
-  if (plan.width <= 0 || plan.height <= 0 || !p_W.allFinite()) return false;
+namespace {
+
+// Visits the plan cells under the footprint that are not free (outside the plan counts), in
+// row-major order, until blocked(x, y) returns false; true when there was none.
+template <typename Blocked>
+bool VisitBlocked(const FloorPlan& plan, const Eigen::Vector2f& p_W, float radius_m,
+                  Blocked&& blocked) {
   const float res = plan.resolution_m;
   const Eigen::Vector2f lo =
       (p_W - plan.origin_W) / res - Eigen::Vector2f::Constant(radius_m / res);
@@ -94,28 +99,56 @@ bool FootprintFree(const FloorPlan& plan, const Eigen::Vector2f& p_W, float radi
   const int x0 = int(std::floor(lo.x() - 0.5f)), x1 = int(std::ceil(hi.x() - 0.5f));
   const int y0 = int(std::floor(lo.y() - 0.5f)), y1 = int(std::ceil(hi.y() - 0.5f));
   const float r2 = radius_m * radius_m;
-  bool any = false;
+  bool any = false, free = true;
   for (int y = y0; y <= y1; ++y)
     for (int x = x0; x <= x1; ++x) {
       if ((plan.CellCenter(x, y) - p_W).squaredNorm() > r2) continue;
       any = true;
-      if (!plan.Contains(x, y) || plan.at(x, y) != PlanCell::kFree) return false;
+      if (plan.Contains(x, y) && plan.at(x, y) == PlanCell::kFree) continue;
+      free = false;
+      if (!blocked(x, y)) return false;
     }
   if (!any) {  // footprint smaller than a cell: the cell under the centre decides
     const Eigen::Vector2f c = (p_W - plan.origin_W) / res;
     const int x = int(std::floor(c.x())), y = int(std::floor(c.y()));
-    return plan.Contains(x, y) && plan.at(x, y) == PlanCell::kFree;
+    if (plan.Contains(x, y) && plan.at(x, y) == PlanCell::kFree) return true;
+    blocked(x, y);
+    return false;
   }
-  return true;
+  return free;
+}
+
+// Footprint samples of a segment: every quarter cell, both ends included.
+int SegmentSteps(const FloorPlan& plan, const Eigen::Vector2f& a_W, const Eigen::Vector2f& b_W) {
+  return std::max(1, int(std::ceil((b_W - a_W).norm() / (0.25f * plan.resolution_m))));
+}
+
+}  // namespace
+
+bool FootprintFree(const FloorPlan& plan, const Eigen::Vector2f& p_W, float radius_m) {
+  if (plan.width <= 0 || plan.height <= 0 || !p_W.allFinite()) return false;
+  return VisitBlocked(plan, p_W, radius_m, [](int, int) { return false; });
 }
 
 bool SegmentFree(const FloorPlan& plan, const Eigen::Vector2f& a_W, const Eigen::Vector2f& b_W,
                  float radius_m) {
-  const float length = (b_W - a_W).norm();
-  const int steps = std::max(1, int(std::ceil(length / (0.25f * plan.resolution_m))));
+  const int steps = SegmentSteps(plan, a_W, b_W);
   for (int i = 0; i <= steps; ++i)
     if (!FootprintFree(plan, a_W + (b_W - a_W) * (float(i) / float(steps)), radius_m)) return false;
   return true;
+}
+
+std::vector<Eigen::Vector2f> FirstContact(const FloorPlan& plan, const Eigen::Vector2f& a_W,
+                                          const Eigen::Vector2f& b_W, float radius_m) {
+  std::vector<Eigen::Vector2f> contact;
+  if (plan.width <= 0 || plan.height <= 0 || !a_W.allFinite() || !b_W.allFinite()) return contact;
+  const int steps = SegmentSteps(plan, a_W, b_W);
+  for (int i = 0; i <= steps && contact.empty(); ++i)
+    VisitBlocked(plan, a_W + (b_W - a_W) * (float(i) / float(steps)), radius_m, [&](int x, int y) {
+      contact.push_back(plan.CellCenter(x, y));
+      return true;
+    });
+  return contact;
 }
 
 Result<Robot> Robot::Create(const RobotParams& params, FloorPlan plan, const RobotState& start,

@@ -8,6 +8,7 @@
 #include <cstdint>
 #include <numbers>
 #include <string>
+#include <vector>
 
 #include "core/camera.h"
 #include "core/pose.h"
@@ -65,6 +66,11 @@ bool FootprintFree(const FloorPlan& plan, const Eigen::Vector2f& p_W, float radi
 // True when the footprint is free at every point of the segment (sampled every quarter cell).
 bool SegmentFree(const FloorPlan& plan, const Eigen::Vector2f& a_W, const Eigen::Vector2f& b_W,
                  float radius_m);
+// What a bumper feels driving the footprint from a_W towards b_W: the centres of the plan cells
+// that block it (obstacle or outside) at the first blocked point of the segment, sampled as
+// SegmentFree does, in row-major order; empty when the segment is free.
+std::vector<Eigen::Vector2f> FirstContact(const FloorPlan& plan, const Eigen::Vector2f& a_W,
+                                          const Eigen::Vector2f& b_W, float radius_m);
 
 class Robot {
  public:

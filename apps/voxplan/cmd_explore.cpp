@@ -42,6 +42,17 @@ namespace {
 namespace fs = std::filesystem;
 using nlohmann::json;
 
+// The camera options' limits (exclusive): RobotParams' field-of-view bounds, and the near depth
+// frames are fused from (sim/explore.cpp), below which a range would fuse nothing.
+constexpr double kMinFovDeg = 1.0, kMaxFovDeg = 179.0;
+constexpr double kMinRangeM = 0.1;
+
+std::string Num(double v) {
+  std::ostringstream s;
+  s << v;
+  return s.str();
+}
+
 struct ExploreOptions {
   std::string scene;
   SceneFrameOptions frame;
@@ -54,6 +65,9 @@ struct ExploreOptions {
   std::string out_dir;
   double voxel_size = 0.05;
   int width = 320, height = 240;
+  // The explorer camera (the mode every planner drives in); defaults are ModeParams' own.
+  double fov_deg = DefaultModeParams(RobotMode::kExplorer).horizontal_fov_deg;
+  double max_range_m = DefaultModeParams(RobotMode::kExplorer).max_range_m;
   bool no_noise = false;
   bool no_labels = false;
   bool no_color = false;
@@ -143,7 +157,8 @@ Result<PointSetFilter> TourFilter(const World& world, const FloorPlan& plan,
   VisibilityParams vp;
   vp.max_depth_m = params.robot.explorer.max_range_m;
   vp.depth_tolerance_m = 0.03f;
-  vp.pose_stride = 2;  // 40° apart in the spins, still inside the 90° field of view
+  // Every other spin frame (40° apart) while that stays inside the field of view.
+  vp.pose_stride = params.robot.explorer.horizontal_fov_deg > 2.f * tp.frame_step_deg ? 2 : 1;
   const PinholeCamera camera = CameraWithFov(params.image_width, params.image_height,
                                              params.robot.explorer.horizontal_fov_deg);
   return ObservableSurfaceFilter(raycaster, camera, poses, vp);
@@ -153,6 +168,14 @@ int RunExploreCommand(const ExploreOptions& o) {
   // Usage checks, before any work.
   if (o.robots < 1) return Fail("--robots must be at least 1", kExitUsage);
   if (!(o.max_time > 0.0)) return Fail("--max-time must be > 0", kExitUsage);
+  if (!(o.fov_deg > kMinFovDeg && o.fov_deg < kMaxFovDeg))
+    return Fail("--fov-deg must lie strictly between " + Num(kMinFovDeg) + " and " +
+                    Num(kMaxFovDeg) + " degrees, got " + Num(o.fov_deg),
+                kExitUsage);
+  if (!(o.max_range_m > kMinRangeM && std::isfinite(o.max_range_m)))
+    return Fail("--max-range-m must be a finite number of metres above " + Num(kMinRangeM) +
+                    ", got " + Num(o.max_range_m),
+                kExitUsage);
   std::error_code ec;
   const fs::path out(o.out_dir);
   if (fs::exists(out, ec) && !fs::is_directory(out, ec))
@@ -219,6 +242,8 @@ int RunExploreCommand(const ExploreOptions& o) {
   params.seed = o.seed;
   params.progress_interval_s = o.progress_interval;
   params.trigger = {float(o.fuse_step_m), float(o.fuse_step_deg)};
+  params.robot.explorer.horizontal_fov_deg = float(o.fov_deg);
+  params.robot.explorer.max_range_m = float(o.max_range_m);
   if (Status s = params.Validate(); !s.ok()) return Fail(s.message(), kExitUsage);
   if (starts.empty()) {
     Result<std::vector<Eigen::Vector2f>> chosen =
@@ -297,8 +322,9 @@ int RunExploreCommand(const ExploreOptions& o) {
   m["completeness"] = RoundTo(quality.completeness, 4);
   m["completeness_all"] = RoundTo(quality.completeness_all, 4);
   m["completeness_reference"] =
-      *filter ? "ground-truth surface observable from a sim tour of the reachable floor "
-                "(5 m range), samples within 5 cm of the final mesh"
+      *filter ? "ground-truth surface observable from a sim tour of the reachable floor (" +
+                    Num(params.robot.explorer.max_range_m) +
+                    " m range), samples within 5 cm of the final mesh"
               : "whole ground-truth surface, samples within 5 cm of the final mesh";
   m["accuracy_rms_m"] = RoundTo(quality.accuracy_rms_m, 4);
   m["accuracy_mean_m"] = RoundTo(quality.accuracy_mean_m, 4);
@@ -448,6 +474,13 @@ Command AddExploreCommand(CLI::App& app) {
       ->capture_default_str();
   sub->add_option("--width", o->width, "Rendered image width, pixels")->capture_default_str();
   sub->add_option("--height", o->height, "Rendered image height, pixels")->capture_default_str();
+  sub->add_option(
+         "--fov-deg", o->fov_deg,
+         "Horizontal field of view of the explorer camera, degrees (the paper's Xtion: 58)")
+      ->capture_default_str();
+  sub->add_option("--max-range-m", o->max_range_m,
+                  "Depth range of the explorer camera, metres (the paper's Xtion: 3)")
+      ->capture_default_str();
   sub->add_flag("--no-noise", o->no_noise, "Fuse clean rendered depth (no Kinect noise)");
   sub->add_flag("--no-labels", o->no_labels, "Fuse no instance labels (no object map)");
   sub->add_flag("--no-color", o->no_color,

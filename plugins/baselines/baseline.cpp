@@ -11,15 +11,17 @@ BaselineWorld ReadBaselineWorld(const vp::WorldView& world, const CommonOptions&
   BaselineWorld b;
   b.input = ReadWorld(world, options);
   if (b.input.robots.empty()) return b;
-  settled->Apply(world, PassOptions(options, b.input), &b.input);
+  const omt::PlannerOptions pass = PassOptions(options, b.input);
+  settled->Apply(world, pass, &b.input);
   ReadHostReach(world, &b.input);
-  omt::ViewSet set = omt::ExtractAccessibleViews(b.input.raster, b.input.clearance, b.input.states,
-                                                 PassOptions(options, b.input), &b.input.accessible,
-                                                 b.input.anchored_robots);
+  omt::ViewSet set =
+      omt::ExtractAccessibleViews(b.input.raster, b.input.clearance, b.input.states, pass,
+                                  &b.input.accessible, b.input.anchored_robots);
   b.views = std::move(set.views);
   b.anchored_robots = set.anchored_robots;
+  b.threshold = pass.importance_threshold;
   for (const omt::TaskView& v : b.views) {
-    b.important.push_back(v.importance > options.omt.importance_threshold ? 1 : 0);
+    b.important.push_back(v.importance > b.threshold ? 1 : 0);
   }
   for (const std::span<const float> field : b.input.robot_fields) {
     b.robot_view_m.emplace_back();
@@ -90,7 +92,8 @@ int NearestView(const std::vector<float>& dist, const std::vector<uint8_t>& allo
 }
 
 void EmitViews(const vp::WorldView& world, vp::PlanOutput& out, const BaselineWorld& b, uint32_t r,
-               const std::vector<int>& view_ids, double dwell_s, const std::string& layer) {
+               const std::vector<int>& view_ids, double dwell_s, const std::string& layer,
+               SettledCells* settled) {
   out.ReplaceTasks(r);
   const vp_robot& robot = b.input.robots[r];
   std::vector<Eigen::Vector2d> points{{robot.x_m, robot.y_m}};
@@ -105,11 +108,14 @@ void EmitViews(const vp::WorldView& world, vp::PlanOutput& out, const BaselineWo
     for (size_t i = 2; i + 1 < leg->size(); i += 2) points.emplace_back((*leg)[i], (*leg)[i + 1]);
     arrivals.emplace_back(k, points.size() - 1);
   }
-  if (arrivals.empty()) return;
   const std::vector<vp_path_point> path = PathWithHeadings(points, robot.theta_rad);
+  std::vector<vp_task> tasks;
   for (const auto& [k, i] : arrivals) {
-    out.AddTask(r, TaskFromView(b.views[size_t(k)], path[i].theta_rad, robot, dwell_s));
+    tasks.push_back(TaskFromView(b.views[size_t(k)], path[i].theta_rad, robot, dwell_s));
+    out.AddTask(r, tasks.back());
   }
+  settled->Sent(r, tasks);
+  if (arrivals.empty()) return;
   if (path.size() < 2) return;  // already standing at its one view
   out.SetPath(r, path);
   std::vector<float> xyz;

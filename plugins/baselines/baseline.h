@@ -16,6 +16,7 @@ struct BaselineWorld {
   WorldInput input;
   std::vector<omt::TaskView> views;  // accessible task views (omt::ExtractAccessibleViews)
   std::vector<uint8_t> important;    // per view: importance above the threshold
+  double threshold = 0.0;            // the importance threshold for this world's camera
   // robot_view_m[r][v]: host geodesic distance from robot r to view v, +inf when unreachable.
   std::vector<std::vector<float>> robot_view_m;
   bool any_important_reachable = false;
@@ -47,9 +48,10 @@ bool SameView(const omt::TaskView& view, const vp_task& task, double radius_m);
 int NearestView(const std::vector<float>& dist, const std::vector<uint8_t>& allowed);
 
 // Replaces robot r's queue by the views in order, with the host's shortest path through them; a
-// view the path cannot reach is left out.
+// view the path cannot reach is left out, and with none r stops. Tells `settled` what r was sent.
 void EmitViews(const vp::WorldView& world, vp::PlanOutput& out, const BaselineWorld& b, uint32_t r,
-               const std::vector<int>& view_ids, double dwell_s, const std::string& layer);
+               const std::vector<int>& view_ids, double dwell_s, const std::string& layer,
+               SettledCells* settled);
 
 // Diagnostics both baselines report: views, views_important, tasks, settled_cells.
 void ReportViews(vp::PlanOutput& out, const BaselineWorld& b, int tasks,

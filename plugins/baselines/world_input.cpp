@@ -174,6 +174,10 @@ WorldInput ReadWorld(const vp::WorldView& world, const CommonOptions& options) {
         in.fov_rad = in.fov_rad > 0.0 ? std::min(in.fov_rad, double(mode.horizontal_fov_rad))
                                       : double(mode.horizontal_fov_rad);
       }
+      if (std::isfinite(mode.max_range_m) && mode.max_range_m > 0.f) {
+        in.range_m = in.range_m > 0.0 ? std::min(in.range_m, double(mode.max_range_m))
+                                      : double(mode.max_range_m);
+      }
     }
     max_radius_m = std::max(max_radius_m, robot.radius_m);
     in.robots.push_back(robot);
@@ -229,11 +233,13 @@ void SettledCells::Update(const vp::WorldView& world, const WorldInput& input,
   // Rays half a cell apart at the far range reach every cell of the fan.
   const double step = 0.5 * g.resolution_m / sensor.d_max_m;
   const int rays = std::max(1, int(std::ceil(sensor.fov_rad / step)));
+  const int32_t event_robot = world.call().event_robot;
+  if (world.event() == VP_EVENT_TASK_FAILED && event_robot >= 0) stalled_.insert(event_robot);
   for (size_t r = 0; r < input.robots.size(); ++r) {
     if (input.robots[r].status != VP_ROBOT_IDLE) continue;
     const auto given = given_.find(uint32_t(r));
-    if (world.event() == VP_EVENT_TASK_FAILED && world.call().event_robot == int32_t(r)) {
-      if (given != given_.end()) given_.erase(given);
+    if (!TookItsView(uint32_t(r), input.robots[r])) {
+      if (given != given_.end()) given_.erase(given);  // its targets were not taken either
       continue;
     }
     bool repeated = false;  // r just took a view of a target it had taken before
@@ -269,6 +275,24 @@ void SettledCells::Update(const vp::WorldView& world, const WorldInput& input,
       });
     }
   }
+}
+
+bool SettledCells::TookItsView(uint32_t r, const vp_robot& robot) const {
+  // The host drives a robot exactly onto its task's position; a centimetre allows for rounding.
+  constexpr float kAtGoalM = 0.01f;
+  if (stalled_.count(r)) return false;
+  const auto goal = goal_.find(r);
+  return goal == goal_.end() ||
+         (Eigen::Vector2f(robot.x_m, robot.y_m) - goal->second).norm() <= kAtGoalM;
+}
+
+void SettledCells::Sent(uint32_t r, std::span<const vp_task> tasks) {
+  if (tasks.empty()) {
+    goal_.erase(r);  // it stops and looks where it stands; a stalled robot stays stalled
+    return;
+  }
+  goal_[r] = {tasks.back().x_m, tasks.back().y_m};
+  stalled_.erase(r);
 }
 
 SettledCells::Key SettledCells::KeyOf(const omt::RasterGeometry& g, int cell) const {
@@ -310,7 +334,18 @@ std::vector<uint8_t> SettledCells::Mask(const omt::RasterGeometry& g) const {
 omt::PlannerOptions PassOptions(const CommonOptions& options, const WorldInput& input) {
   omt::PlannerOptions o = options.omt;
   o.robot_radius_m = input.robot_radius_m;
-  if (options.fov_from_robot && input.fov_rad > 0.0) o.views.sensor.fov_rad = input.fov_rad;
+  omt::SensorParams& s = o.views.sensor;
+  // The host's angles and ranges are floats: a camera equal to the sensor is not narrower.
+  constexpr double kRounding = 1e-5;
+  if (input.fov_rad > 0.0 &&
+      (options.fov_from_robot || input.fov_rad < s.fov_rad * (1 - kRounding)))
+    s.fov_rad = input.fov_rad;
+  if (input.range_m > 0.0 && input.range_m < s.d_max_m * (1 - kRounding)) {
+    // Nothing is seen past the camera's range, however good the sensor model is there.
+    s.d_max_m = s.d_inf_m = input.range_m;
+    s.d_min_m = std::min(s.d_min_m, input.range_m);
+  }
+  o.importance_threshold *= omt::ViewCapacity(s) / omt::ViewCapacity(options.omt.views.sensor);
   return o;
 }
 

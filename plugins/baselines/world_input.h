@@ -70,6 +70,7 @@ struct WorldInput {
   float min_clearance_m = 0.f;     // for host geodesic queries: robot_radius_m + margin
   double surface_voxels_ms = 0.0;  // spent in the host's surface voxel query
   double fov_rad = 0.0;            // narrowest horizontal FOV of the robots' modes; 0: unknown
+  double range_m = 0.0;            // shortest depth range of the robots' modes; 0: unknown
   // ReadHostReach: per robot the host's geodesic field (min_clearance_m; host memory, valid
   // during the plan call), the cells any of them reaches, and how many robots reach any cell (a
   // robot the host cannot place reaches none).
@@ -94,8 +95,10 @@ void ReadHostReach(const vp::WorldView& world, WorldInput* input);
 class SettledCells {
  public:
   // Adds the unresolved cells of every idle robot's camera fan (between the sensor's near and
-  // far range, up to the first surface on each ray); a robot whose task just failed did not
-  // take its view and adds nothing.
+  // far range, up to the first surface on each ray). Only a robot that took its view counts: one
+  // standing at the last task it was sent to (or never sent anywhere, or told to stop). A robot
+  // whose task failed adds nothing until it has reached a task sent after the failure: it
+  // stopped where a drive was refused, often facing the very space it could not get to.
   void Update(const vp::WorldView& world, const WorldInput& input, const omt::SensorParams& sensor,
               const omt::UncertaintyParams& uncertainty);
   // Update, then input->raster.settled = Mask(its geometry).
@@ -111,16 +114,25 @@ class SettledCells {
   void Remember(uint32_t r, const omt::RasterGeometry& g, const std::vector<omt::TaskView>& views,
                 const std::vector<int>& ids);
   static constexpr int kRepeatLimit = 2;
+  // Robot r's queue was just replaced by `tasks` (none: told to stop where it is).
+  void Sent(uint32_t r, std::span<const vp_task> tasks);
 
  private:
   using Key = std::pair<long, long>;  // global cell (floor(x / res), floor(y / res))
   Key KeyOf(const omt::RasterGeometry& g, int cell) const;
+  bool TookItsView(uint32_t r, const vp_robot& robot) const;
   std::set<Key> cells_;
   std::map<uint32_t, std::vector<Key>> given_;  // per robot: targets of its last tasks
   std::map<Key, int> taken_;                    // per target: views of it taken so far
+  std::map<uint32_t, Eigen::Vector2f> goal_;    // per robot: where its queue ends
+  std::set<uint32_t> stalled_;                  // robots whose task failed since they were sent
 };
 
-// options.omt with this world's robot radius.
+// options.omt for this world: its robot radius; views (and settled fans) no wider and no longer
+// than the robots' camera sees (fov_from_robot: exactly as wide); the importance threshold
+// scaled by what such a view can see against the sensor it was set for (ViewCapacity), so it
+// asks the same share of a full view of any camera. Unchanged for a camera at least as wide and
+// long as the paper's sensor.
 omt::PlannerOptions PassOptions(const CommonOptions& options, const WorldInput& input);
 
 // The host's distance_matrix / shortest_path as the OMT pass's geodesics; *host_ms accumulates

@@ -59,11 +59,12 @@ class GreedyPlanner : public vp::Planner {
       for (size_t v = 0; v < allowed.size(); ++v) allowed[v] &= !claimed[v];
       const int k = NearestView(b.robot_view_m[r], allowed);
       if (k < 0) {
-        out.ReplaceTasks(r);  // nothing left for it: stop rather than finish a stale task
+        // Nothing left for it: stop rather than finish a stale task.
+        EmitViews(world, out, b, r, {}, options_.dwell_s, "greedy_paths", &settled_);
         continue;
       }
       claimed[size_t(k)] = 1;
-      EmitViews(world, out, b, r, {k}, options_.dwell_s, "greedy_paths");
+      EmitViews(world, out, b, r, {k}, options_.dwell_s, "greedy_paths", &settled_);
       ++tasks;
     }
     return tasks;
@@ -110,10 +111,11 @@ class GreedyPlanner : public vp::Planner {
       if (!planned[r]) continue;
       const int k = NearestView(b.robot_view_m[r], assigned[r]);
       if (k < 0) {
-        out.ReplaceTasks(r);  // no view of its own: stop rather than finish a stale task
+        // No view of its own: stop rather than finish a stale task.
+        EmitViews(world, out, b, r, {}, options_.dwell_s, "greedy_paths", &settled_);
         continue;
       }
-      EmitViews(world, out, b, r, {k}, options_.dwell_s, "greedy_paths");
+      EmitViews(world, out, b, r, {k}, options_.dwell_s, "greedy_paths", &settled_);
       ++tasks;
     }
     return tasks;

@@ -26,7 +26,9 @@ struct PlannerOptions {
   double robot_radius_m = 0.18;
   double geodesic_cell_m = 0.2;  // node spacing of the internal geodesic grid
   double snap_radius_m = 0.5;    // a robot off accessible cells starts from the nearest within this
-  double importance_threshold = 1.5;  // §4 termination
+  // §4 termination, for the paper's sensor (SensorParams' defaults); a caller whose views see
+  // more or less scales it by ViewCapacity (plugins/baselines PassOptions).
+  double importance_threshold = 1.5;
   TaskViewParams views;  // max_views and robot_radius_m are set from kappa and robot_radius_m
   AssignmentParams assignment;  // refine is set from the flag below
   TspParams tsp;

@@ -39,7 +39,8 @@ class OmtPlanner : public vp::Planner {
       in = ReadWorld(world, options_);
     }
     if (in.robots.empty()) return;  // nobody to plan for; not "done" either
-    settled_.Apply(world, PassOptions(options_, in), &in);
+    const omt::PlannerOptions pass = PassOptions(options_, in);
+    settled_.Apply(world, pass, &in);
     out.Diagnostic("settled_cells", double(settled_.size()));
     out.Diagnostic("surface_voxels_ms", in.surface_voxels_ms);
 
@@ -53,14 +54,13 @@ class OmtPlanner : public vp::Planner {
     }
     omt::PlanResult result;
     const double start_s = world.ElapsedS();
-    const omt::Status status =
-        omt::PlanOmt(in.raster, &in.clearance, in.states, PassOptions(options_, in), &result,
-                     options_.geodesics == "host" ? &provider : nullptr);
+    const omt::Status status = omt::PlanOmt(in.raster, &in.clearance, in.states, pass, &result,
+                                            options_.geodesics == "host" ? &provider : nullptr);
     out.Diagnostic("omt_ms", (world.ElapsedS() - start_s) * 1e3);
     out.Diagnostic("host_geodesics_ms", host_ms);
     if (!status.ok())
       throw vp::Error(VP_ERROR_PLUGIN, "omt: planning pass failed: " + status.message);
-    Report(result, out);
+    Report(result, pass.importance_threshold, out);
     out.DebugPoints("omt_views", ViewPointsXyz(result.views, in.map.floor_z_m), kViewColor);
     if (result.terminated) {
       if (result.anchored_robots > 0) {
@@ -74,17 +74,17 @@ class OmtPlanner : public vp::Planner {
     }
     vp::StageTimer timer(world, out, "output");
     for (uint32_t r = 0; r < in.robots.size(); ++r) {
-      Emit(in, result, r, out);
+      settled_.Sent(r, Emit(in, result, r, out));
       settled_.Remember(r, in.raster.geometry, result.views, result.robots[r].tasks);
     }
   }
 
  private:
-  void Report(const omt::PlanResult& result, vp::PlanOutput& out) const {
+  void Report(const omt::PlanResult& result, double threshold, vp::PlanOutput& out) const {
     int important = 0, unassigned = 0;
     double max_importance = 0.0;
     for (const omt::TaskView& v : result.views) {
-      important += v.importance > options_.omt.importance_threshold;
+      important += v.importance > threshold;
       max_importance = std::max(max_importance, v.importance);
     }
     for (int robot : result.assignment.task_robot) unassigned += robot < 0;
@@ -97,6 +97,7 @@ class OmtPlanner : public vp::Planner {
     out.Diagnostic("views", double(result.views.size()));
     out.Diagnostic("views_important", important);
     out.Diagnostic("max_importance", max_importance);
+    out.Diagnostic("importance_threshold", threshold);
     out.Diagnostic("tasks", tasks);
     out.Diagnostic("views_unassigned", unassigned);
     out.Diagnostic("assignment_energy", result.assignment.cost);
@@ -107,12 +108,14 @@ class OmtPlanner : public vp::Planner {
   }
 
   // Robot r's queue becomes its task views in TSP order, with the smoothed path and the camera
-  // yaw along it; no task this pass stops the robot (its views went to others).
-  void Emit(const WorldInput& in, const omt::PlanResult& result, uint32_t r,
-            vp::PlanOutput& out) const {
+  // yaw along it; no task this pass stops the robot (its views went to others). Returns the
+  // tasks.
+  std::vector<vp_task> Emit(const WorldInput& in, const omt::PlanResult& result, uint32_t r,
+                            vp::PlanOutput& out) const {
     out.ReplaceTasks(r);
     const omt::RobotPlan& plan = result.robots[r];
-    if (plan.tasks.empty() || plan.path.empty()) return;
+    std::vector<vp_task> tasks;
+    if (plan.tasks.empty() || plan.path.empty()) return tasks;
     const vp_robot& robot = in.robots[r];
     std::vector<Eigen::Vector2d> points;
     std::map<int, size_t> task_point;  // view id -> path point standing for it
@@ -126,7 +129,8 @@ class OmtPlanner : public vp::Planner {
       const auto it = task_point.find(k);
       // The base arrives along the path; the camera joint turns to the view's target.
       const double theta = it != task_point.end() ? path[it->second].theta_rad : view.yaw_rad;
-      out.AddTask(r, TaskFromView(view, theta, robot, options_.dwell_s));
+      tasks.push_back(TaskFromView(view, theta, robot, options_.dwell_s));
+      out.AddTask(r, tasks.back());
     }
     out.SetPath(r, path);
 
@@ -151,6 +155,7 @@ class OmtPlanner : public vp::Planner {
     }
     out.SetCameraTrajectory(r, samples);
     out.DebugPolyline("omt_paths", xyz, kPathColor);
+    return tasks;
   }
 
   CommonOptions options_;

@@ -214,6 +214,13 @@ std::vector<TaskView> ExtractTaskViews(const OccupancyRaster& raster,
   return views;
 }
 
+double ViewCapacity(const SensorParams& sensor) {
+  // ∫ψ(d) d dd over [0, d_max]: the ramp to d_min gives d_min² / 3, the flat part the rest.
+  const double d_min = std::min(sensor.d_min_m, sensor.d_max_m);
+  return sensor.fov_rad *
+         (d_min * d_min / 3.0 + 0.5 * (sensor.d_max_m * sensor.d_max_m - d_min * d_min));
+}
+
 bool ShouldTerminate(const std::vector<TaskView>& views, double importance_threshold) {
   return std::none_of(views.begin(), views.end(),
                       [&](const TaskView& v) { return v.importance > importance_threshold; });

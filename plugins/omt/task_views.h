@@ -77,6 +77,10 @@ std::vector<TaskView> ExtractTaskViews(const OccupancyRaster& raster,
                                        const TaskViewParams& params,
                                        const std::vector<std::uint8_t>* accessible = nullptr);
 
+// What one view can see at most, in m²: the fan's area weighted by ψ up to d_max (the importance
+// of a view into unknown space with nothing in the way, before the reference-cell scale).
+double ViewCapacity(const SensorParams& sensor);
+
 // Termination test of §4: true when no view has importance above the threshold (1.5).
 bool ShouldTerminate(const std::vector<TaskView>& views, double importance_threshold = 1.5);
 

@@ -60,10 +60,11 @@ class VoronoiPlanner : public vp::Planner {
         }
       }
       if (chosen.empty()) {
-        out.ReplaceTasks(r);  // its region is explored: stop rather than finish a stale task
+        // Its region is explored: stop rather than finish a stale task.
+        EmitViews(world, out, b, r, {}, options_.dwell_s, "voronoi_paths", &settled_);
         continue;
       }
-      EmitViews(world, out, b, r, chosen, options_.dwell_s, "voronoi_paths");
+      EmitViews(world, out, b, r, chosen, options_.dwell_s, "voronoi_paths", &settled_);
       tasks += int(chosen.size());
     }
     ReportViews(out, b, tasks, settled_);

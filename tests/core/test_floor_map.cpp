@@ -359,6 +359,43 @@ float PathLength(const std::vector<Eigen::Vector2f>& path) {
   return length;
 }
 
+TEST(FloorMap, MarkedObstaclesStayWhateverTheVolumeSays) {
+  // A bumper's contacts shut the doorway (x 20, y 20..27) the camera saw free: no way from the
+  // west room to the east one any more, through later updates and a rebuild alike.
+  TsdfVolume volume = LayoutVolume();
+  FloorMap map = ProjectFloor(volume, FloorMapParams{});
+  GeodesicCache cache;
+  ASSERT_TRUE(std::isfinite(
+      cache.Field(map, Center(10, 40), Params(0.0f))
+          ->At(30 - map.geometry().origin_cell.x(), 40 - map.geometry().origin_cell.y())));
+  std::vector<Eigen::Vector2f> doorway;
+  for (int y = 20; y < 28; ++y) doorway.push_back(Center(20, y));
+  const uint64_t before = map.revision();
+  EXPECT_TRUE(map.MarkObstacles(doorway));
+  EXPECT_GT(map.revision(), before);
+  const auto shut = [&](const FloorMap& m) {
+    for (int y = 20; y < 28; ++y) EXPECT_EQ(MapAt(m, 20, y), FloorCell::kObstacle) << y;
+    const Eigen::Vector2i o = m.geometry().origin_cell;
+    EXPECT_EQ(cache.Field(m, Center(10, 40), Params(0.0f))->At(30 - o.x(), 40 - o.y()), kInf);
+  };
+  shut(map);
+  // Marked again: nothing changes.
+  const uint64_t marked = map.revision();
+  EXPECT_FALSE(map.MarkObstacles(doorway));
+  EXPECT_EQ(map.revision(), marked);
+  // The volume still says free there; re-projecting its blocks keeps the marks.
+  ASSERT_TRUE(map.Update(volume, volume.SortedBlockIndices()).ok());
+  shut(map);
+  ASSERT_TRUE(map.Rebuild(volume).ok());
+  shut(map);
+  // A contact beyond the raster grows it; the cell is an obstacle, its new neighbours unknown.
+  const std::vector<Eigen::Vector2f> far = {Center(100, 5)};
+  EXPECT_TRUE(map.MarkObstacles(far));
+  EXPECT_EQ(MapAt(map, 100, 5), FloorCell::kObstacle);
+  EXPECT_EQ(MapAt(map, 99, 5), FloorCell::kUnknown);
+  EXPECT_EQ(MapAt(map, 10, 40), FloorCell::kFree);  // the rest is as it was
+}
+
 TEST(Geodesic, StraightLinesAreEuclidean) {
   const FloorMap map = ProjectFloor(SharedLayout(), FloorMapParams{});
   GeodesicCache cache;

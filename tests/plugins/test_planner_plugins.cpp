@@ -9,6 +9,7 @@
 #include <map>
 #include <set>
 #include <string>
+#include <tuple>
 #include <vector>
 
 #include "plugins/host/plugin_host.h"
@@ -271,6 +272,97 @@ TEST(Planners, DoneOnceAnIdleRobotLookedAtWhatStaysUnknown) {
       const PlanResult r = MustPlan(*planner, world);
       EXPECT_EQ(r.done, theta == 0.f) << name << " facing " << theta;
       EXPECT_EQ(r.robots[0].tasks.empty(), theta == 0.f) << name << " facing " << theta;
+    }
+  }
+}
+
+TEST(Planners, AFailedTaskSettlesNothingUntilTheRobotTakesAView) {
+  // The pocket of the test above, 2 m ahead of a robot whose drive towards it was refused: it
+  // stands where it stopped, facing the pocket, idle, and has not looked from any view. Neither
+  // the failure call nor a later idle call may settle the pocket (it would end the run with the
+  // pocket unseen); once the robot stands at a view it was sent to after the failure, it may.
+  for (const std::string& name : kPlanners) {
+    test::RasterWorld world(80, 40, 0.05f);
+    world.Walls();
+    world.Fill(50, 15, 55, 25, FloorCell::kUnknown);
+    world.Finish();
+    world.set_surface_weight(1000.f);
+    PlannerRobot& robot = world.AddRobot(10, 20, 0.18f);
+    robot.theta_rad = 3.1416f;  // facing away: the start settles nothing of the pocket
+    auto planner = MustLoad(name);
+    ASSERT_TRUE(planner);
+    const PlanResult start = MustPlan(*planner, world);
+    ASSERT_FALSE(start.done) << name;
+    ASSERT_FALSE(start.robots[0].tasks.empty()) << name;
+    world.robots()[0].theta_rad = 0.f;  // turned towards its task, then bumped
+    PlanRequest failed;
+    failed.event = PlanEvent::kTaskFailed;
+    failed.event_robot = 0;
+    failed.call_index = 1;
+    failed.failed_task = start.robots[0].tasks[0];
+    const PlanResult after_failure = MustPlan(*planner, world, failed);
+    EXPECT_FALSE(after_failure.done) << name;
+    PlanRequest idle;
+    idle.event = PlanEvent::kRobotIdle;
+    idle.event_robot = 0;
+    idle.call_index = 2;
+    const PlanResult still = MustPlan(*planner, world, idle);
+    EXPECT_FALSE(still.done) << name << ": settled the pocket from where the drive failed";
+    ASSERT_FALSE(still.robots[0].tasks.empty()) << name;
+    // It takes its view: standing there, facing the target, the pocket is looked at in vain.
+    const PlannerTask& view = still.robots[0].tasks.back();
+    world.robots()[0].position_m = view.position_m;
+    world.robots()[0].theta_rad = view.theta_rad;
+    world.robots()[0].camera_yaw_rad = view.camera_yaw_rad;
+    idle.call_index = 3;
+    EXPECT_TRUE(MustPlan(*planner, world, idle).done) << name;
+  }
+}
+
+TEST(Planners, ImportanceThresholdScalesWithWhatTheCameraSees) {
+  // 1.5 is the paper's bar for its sensor's views (58°, ψ flat from 0.5 to 3 m). Views reach no
+  // further and no wider than the robots' camera, and the bar scales with what such a view can
+  // see (the ψ-weighted area of its fan), so a camera at least as good as the paper's keeps it.
+  const double deg = M_PI / 180.0;
+  const auto capacity = [](double fov_rad, double range_m) {  // ∫ψ(d) d dd, d_min = 0.5 m
+    return fov_rad * (0.25 / 3.0 + 0.5 * (range_m * range_m - 0.25));
+  };
+  constexpr double kFloatTol = 1e-6;  // angles and ranges cross the plugin boundary as floats
+  const std::vector<std::tuple<double, float, double>> cameras = {
+      {90.0, 5.f, 1.5},  // the explorer's default
+      {58.0, 3.f, 1.5},  // the paper's Xtion
+      {29.0, 3.f, 0.75},
+      {58.0, 1.5f, 1.5 * capacity(58 * deg, 1.5) / capacity(58 * deg, 3.0)}};
+  for (const auto& [fov_deg, range_m, want] : cameras) {
+    test::RasterWorld world = SmallApartment();
+    for (PlannerRobot& r : world.robots()) {
+      r.modes[0].horizontal_fov_rad = float(fov_deg * deg);
+      r.modes[0].max_range_m = range_m;
+    }
+    auto planner = MustLoad("omt");
+    ASSERT_TRUE(planner);
+    const double got = Diagnostics(MustPlan(*planner, world)).at("importance_threshold");
+    EXPECT_NEAR(got, want, kFloatTol * want) << fov_deg << " deg, " << range_m << " m";
+    if (fov_deg >= 58.0 && range_m >= 3.f) EXPECT_EQ(got, 1.5);  // exactly the paper's
+  }
+  // A pocket of 2 x 2 unknown cells in a scanned room: a view of it is worth about 1 (4 cells
+  // of a quarter reference cell each). Below the bar for the default camera, so the planners
+  // are done; above it for a camera half as wide (bar 0.75), which still sends a robot there.
+  for (const std::string& name : kPlanners) {
+    for (const double fov_deg : {90.0, 29.0}) {
+      test::RasterWorld world(80, 40, 0.05f);
+      world.Walls();
+      world.Fill(50, 20, 51, 21, FloorCell::kUnknown);
+      world.Finish();
+      world.set_surface_weight(1000.f);
+      PlannerRobot& robot = world.AddRobot(10, 20, 0.18f);
+      robot.theta_rad = 3.1416f;  // facing away: its first look settles nothing of the pocket
+      robot.modes[0].horizontal_fov_rad = float(fov_deg * deg);
+      auto planner = MustLoad(name);
+      ASSERT_TRUE(planner);
+      const PlanResult r = MustPlan(*planner, world);
+      EXPECT_EQ(r.done, fov_deg == 90.0) << name << " " << fov_deg << " deg";
+      EXPECT_EQ(r.robots[0].tasks.empty(), fov_deg == 90.0) << name << " " << fov_deg << " deg";
     }
   }
 }

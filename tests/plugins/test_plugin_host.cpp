@@ -130,7 +130,7 @@ TEST(PluginHost, UnknownNameListsTheAvailablePlanners) {
   EXPECT_EQ(planner.status().code(), StatusCode::kNotFound);
   const std::string& m = planner.status().message();
   EXPECT_TRUE(Contains(m, "unknown planner 'nosuch'")) << m;
-  EXPECT_TRUE(Contains(m, "garbage, minimal, noentry, probe, throwing")) << m;
+  EXPECT_TRUE(Contains(m, "garbage, goto, minimal, noentry, probe, throwing")) << m;
   const std::vector<std::string> names = AvailablePlanners({kDir});
   EXPECT_EQ(names.front(), "abi2");  // sorted
   // A name never becomes a path outside the search path.

@@ -6,8 +6,10 @@
 #include <cmath>
 #include <functional>
 #include <limits>
+#include <map>
 #include <memory>
 #include <queue>
+#include <string>
 #include <utility>
 #include <vector>
 
@@ -179,6 +181,89 @@ TEST(Explore, StartsAreFreeSideBySideAndBadOnesAreRefused) {
   ASSERT_TRUE(planner);
   Result<ExploreResult> run = RunExplore(s.world, s.plan, {wall}, *planner, FastParams(), {});
   EXPECT_FALSE(run.ok());
+}
+
+std::unique_ptr<LoadedPlanner> Goto(const Eigen::Vector2f& goal_W) {
+  const std::string config =
+      "{\"x\": " + std::to_string(goal_W.x()) + ", \"y\": " + std::to_string(goal_W.y()) + "}";
+  Result<std::unique_ptr<LoadedPlanner>> planner =
+      LoadPlanner(VOXPLAN_GOTO_TEST_PLANNER, {.config_json = config, .seed = 1, .search_path = {}});
+  EXPECT_TRUE(planner.ok()) << planner.status().message();
+  return planner.ok() ? std::move(planner).value() : nullptr;
+}
+
+TEST(Explore, BumperPutsAnObstacleTheCameraNeverSeesOnTheMap) {
+  // The robot is sent 1.6 m across its room; the true plan has a 0.4 m bar across the way that the
+  // scene (what the camera renders) lacks. Each refused drive puts what it ran into on the floor
+  // map, so the host's next route bends around the bar and the robot arrives; without that it
+  // is routed into the bar again and again until the time limit.
+  constexpr float kLegM = 1.6f, kBarHalfM = 0.2f, kDetourM = 0.5f;
+  const Scene& s = SmallApartment();
+  ExploreParams params = FastParams();
+  params.max_time_s = 240.0;
+  const float radius = params.robot.radius_m;
+  // The first leg (cells in row-major order, then directions) whose corridor is free wide
+  // enough for a detour round either end of the bar.
+  Eigen::Vector2f start = Eigen::Vector2f::Zero(), goal = start, dir = start;
+  for (int i = 0; i < s.plan.width * s.plan.height && dir.isZero(); ++i) {
+    const Eigen::Vector2f c = s.plan.CellCenter(i % s.plan.width, i / s.plan.width);
+    for (const Eigen::Vector2f d : {Eigen::Vector2f(1.f, 0.f), Eigen::Vector2f(0.f, 1.f)}) {
+      if (SegmentFree(s.plan, c, c + kLegM * d, kBarHalfM + kDetourM)) {
+        start = c;
+        goal = c + kLegM * d;
+        dir = d;
+        break;
+      }
+    }
+  }
+  ASSERT_FALSE(dir.isZero()) << "no room for the leg";
+  FloorPlan plan = s.plan;
+  const Eigen::Vector2f middle = 0.5f * (start + goal), side(-dir.y(), dir.x());
+  for (int y = 0; y < plan.height; ++y)
+    for (int x = 0; x < plan.width; ++x) {
+      const Eigen::Vector2f c = plan.CellCenter(x, y) - middle;
+      if (std::abs(c.dot(dir)) <= 0.5f * plan.resolution_m && std::abs(c.dot(side)) <= kBarHalfM)
+        plan.cells[size_t(y) * size_t(plan.width) + size_t(x)] = PlanCell::kObstacle;
+    }
+  ASSERT_FALSE(SegmentFree(plan, start, goal, radius));
+  std::unique_ptr<LoadedPlanner> planner = Goto(goal);
+  ASSERT_TRUE(planner);
+  Result<ExploreResult> run = RunExplore(s.world, plan, {start}, *planner, params, {});
+  ASSERT_TRUE(run.ok()) << run.status().message();
+  EXPECT_EQ(run->terminated, "done") << "stopped at t=" << run->time_s;
+  EXPECT_GE(run->failed_tasks, 1u);  // it did run into the bar
+  const RobotSample& end = run->tracks[0].samples.back();
+  EXPECT_LT((Eigen::Vector2f(float(end.x_m), float(end.y_m)) - goal).norm(), 1e-3f);
+  // The bar is on the floor map where the robot touched it (the camera never sees any of it).
+  size_t marked = 0;
+  for (int y = 0; y < plan.height; ++y)
+    for (int x = 0; x < plan.width; ++x)
+      if (plan.at(x, y) != s.plan.at(x, y))
+        marked += run->floor->AtPoint(plan.CellCenter(x, y)) == FloorCell::kObstacle;
+  EXPECT_GE(marked, 1u);
+  size_t bumps = 0;
+  for (const std::string& line : run->plan_log) bumps += line.find("bumped into") != line.npos;
+  EXPECT_GE(bumps, 1u);
+  EXPECT_LE(run->failed_tasks, bumps);  // each failure here is a bump that marked something new
+}
+
+TEST(Explore, PlannersSeeTheExplorerCamera) {
+  const Scene& s = SmallApartment();
+  ExploreParams params = FastParams();
+  params.max_time_s = 20.0;
+  params.robot.explorer.horizontal_fov_deg = 58.f;
+  params.robot.explorer.max_range_m = 3.f;
+  const Eigen::Vector2f start =
+      ChooseStarts(s.plan, s.world.rooms, 1, params.robot.radius_m).value()[0];
+  std::unique_ptr<LoadedPlanner> planner = Goto(start);
+  ASSERT_TRUE(planner);
+  Result<ExploreResult> run = RunExplore(s.world, s.plan, {start}, *planner, params, {});
+  ASSERT_TRUE(run.ok()) << run.status().message();
+  ASSERT_FALSE(run->plan_calls.empty());
+  std::map<std::string, double> seen(run->plan_calls[0].diagnostics.begin(),
+                                     run->plan_calls[0].diagnostics.end());
+  EXPECT_NEAR(seen["explorer_fov_rad"], 58.0 * M_PI / 180.0, 1e-6);
+  EXPECT_NEAR(seen["explorer_max_range_m"], 3.0, 1e-6);
 }
 
 // One frame of the small apartment from the first start, fused into `map` and `floor`.

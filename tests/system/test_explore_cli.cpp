@@ -1,8 +1,9 @@
 // `voxplan explore` run as a user would: a short run writes every output and repeats itself
-// byte for byte; an unknown planner lists the available ones; robots that cannot be placed are
-// refused before the run.
+// byte for byte; an unknown planner lists the available ones; a camera out of range and robots
+// that cannot be placed are refused before the run.
 #include <gtest/gtest.h>
 
+#include <array>
 #include <filesystem>
 #include <nlohmann/json.hpp>
 #include <string>
@@ -89,6 +90,22 @@ TEST(ExploreCli, UnknownPlannerListsTheAvailableOnes) {
   EXPECT_NE(r.err.find("unknown planner 'no_such_planner'; available:"), std::string::npos)
       << Describe(r);
   EXPECT_NE(r.err.find("greedy"), std::string::npos) << Describe(r);
+  EXPECT_FALSE(fs::exists(dir / "out"));
+}
+
+TEST(ExploreCli, RefusesACameraItCannotSimulate) {
+  test::TempDir dir("explore_cli_camera");
+  for (const auto& [option, value, expect] : std::vector<std::array<std::string, 3>>{
+           {"--fov-deg", "0", "--fov-deg must lie strictly between 1 and 179 degrees, got 0"},
+           {"--fov-deg", "180", "--fov-deg must lie strictly between 1 and 179"},
+           {"--fov-deg", "nan", "--fov-deg must lie"},
+           {"--max-range-m", "0.05", "--max-range-m must be a finite number of metres above 0.1"},
+           {"--max-range-m", "inf", "--max-range-m must be"}}) {
+    const RunResult r = RunCli({"explore", "--scene", "apartment:size=S,seed=1", "--planner",
+                                "greedy", option, value, "--out", (dir / "out").string()});
+    EXPECT_EQ(r.exit_code, 2) << Describe(r);
+    EXPECT_NE(r.err.find(expect), std::string::npos) << Describe(r);
+  }
   EXPECT_FALSE(fs::exists(dir / "out"));
 }
 
