@@ -108,6 +108,11 @@ bool FloorMap::MarkObstacles(std::span<const Eigen::Vector2f> points_W) {
   return changed;
 }
 
+bool FloorMap::Marked(const Eigen::Vector2f& p_W) const {
+  return !marked_.empty() && marked_.count({FloorToInt(p_W.x() / geometry_.cell_size_m),
+                                            FloorToInt(p_W.y() / geometry_.cell_size_m)}) != 0;
+}
+
 bool FloorMap::ApplyMarks(const std::vector<std::pair<int, int>>& cells) {
   if (cells.empty()) return false;
   const int cpb = kBlockSide / params_.cell_voxels;

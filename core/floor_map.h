@@ -82,6 +82,8 @@ class FloorMap {
   // says: what a robot's bumper ran into, which its camera may never see (too low, or in the
   // blind zone in front of it). Grows the raster to cover them; true when a cell changed.
   bool MarkObstacles(std::span<const Eigen::Vector2f> points_W);
+  // Whether the cell holding p_W was marked by MarkObstacles.
+  bool Marked(const Eigen::Vector2f& p_W) const;
 
   const FloorMapParams& params() const { return params_; }
   const FloorGeometry& geometry() const { return geometry_; }

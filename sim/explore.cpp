@@ -224,12 +224,26 @@ void Explorer::Fail(RobotRun& r, const std::string& why) {
 
 // The bumper: what a refused drive on the host's route ran into goes on the floor map as
 // obstacle, so the host's routes and the planner's raster avoid it. Without it a robot whose camera
-// never sees the obstacle (too low, or too close) is routed into it again and again.
+// never sees the obstacle (too low, or too close) is routed into it again and again. A contact
+// within two cells of an obstacle the camera put on the map is that wall, a cell off on the map's
+// grid, not something unseen: marking it narrows the doorway (OMT on apartment M1 then sent its
+// robots back and forth through one door for 1000 s), so only contacts clear of seen walls count.
 void Explorer::Bump(RobotRun& r, const Eigen::Vector2f& goal_W) {
   const Robot& robot = r.robot;
-  const std::vector<Eigen::Vector2f> contact =
-      FirstContact(robot.plan(), robot.state().position_W, goal_W, robot.params().radius_m);
-  if (!floor_->MarkObstacles(contact)) return;
+  constexpr int kWallCells = 2;
+  const float cell_m = floor_->geometry().cell_size_m;
+  std::vector<Eigen::Vector2f> contact;
+  for (const Eigen::Vector2f& p :
+       FirstContact(robot.plan(), robot.state().position_W, goal_W, robot.params().radius_m)) {
+    bool known = false;
+    for (int dy = -kWallCells; dy <= kWallCells && !known; ++dy)
+      for (int dx = -kWallCells; dx <= kWallCells && !known; ++dx) {
+        const Eigen::Vector2f q = p + cell_m * Eigen::Vector2f(float(dx), float(dy));
+        known = floor_->AtPoint(q) == FloorCell::kObstacle && !floor_->Marked(q);
+      }
+    if (!known) contact.push_back(p);
+  }
+  if (contact.empty() || !floor_->MarkObstacles(contact)) return;
   result_.plan_log.push_back("t=" + Fmt(r.t_s) + " robot " + std::to_string(r.index) +
                              " bumped into " + std::to_string(contact.size()) +
                              " floor cells near (" + Fmt(contact.front().x()) + ", " +

@@ -343,7 +343,9 @@ TEST(Planners, ImportanceThresholdScalesWithWhatTheCameraSees) {
     ASSERT_TRUE(planner);
     const double got = Diagnostics(MustPlan(*planner, world)).at("importance_threshold");
     EXPECT_NEAR(got, want, kFloatTol * want) << fov_deg << " deg, " << range_m << " m";
-    if (fov_deg >= 58.0 && range_m >= 3.f) EXPECT_EQ(got, 1.5);  // exactly the paper's
+    if (fov_deg >= 58.0 && range_m >= 3.f) {
+      EXPECT_EQ(got, 1.5);  // exactly the paper's
+    }
   }
   // A pocket of 2 x 2 unknown cells in a scanned room: a view of it is worth about 1 (4 cells
   // of a quarter reference cell each). Below the bar for the default camera, so the planners

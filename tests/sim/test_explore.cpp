@@ -207,7 +207,7 @@ TEST(Explore, BumperPutsAnObstacleTheCameraNeverSeesOnTheMap) {
   Eigen::Vector2f start = Eigen::Vector2f::Zero(), goal = start, dir = start;
   for (int i = 0; i < s.plan.width * s.plan.height && dir.isZero(); ++i) {
     const Eigen::Vector2f c = s.plan.CellCenter(i % s.plan.width, i / s.plan.width);
-    for (const Eigen::Vector2f d : {Eigen::Vector2f(1.f, 0.f), Eigen::Vector2f(0.f, 1.f)}) {
+    for (const Eigen::Vector2f& d : {Eigen::Vector2f(1.f, 0.f), Eigen::Vector2f(0.f, 1.f)}) {
       if (SegmentFree(s.plan, c, c + kLegM * d, kBarHalfM + kDetourM)) {
         start = c;
         goal = c + kLegM * d;
