@@ -98,8 +98,7 @@ bool FloorMap::MarkObstacles(std::span<const Eigen::Vector2f> points_W) {
   std::vector<std::pair<int, int>> added;
   for (const Eigen::Vector2f& p : points_W) {
     if (!p.allFinite()) continue;
-    const std::pair<int, int> c = {FloorToInt(p.x() / geometry_.cell_size_m),
-                                   FloorToInt(p.y() / geometry_.cell_size_m)};
+    const std::pair<int, int> c = GlobalCell(p);
     if (marked_.insert(c).second) added.push_back(c);
   }
   if (added.empty()) return false;
@@ -108,9 +107,26 @@ bool FloorMap::MarkObstacles(std::span<const Eigen::Vector2f> points_W) {
   return changed;
 }
 
-bool FloorMap::Marked(const Eigen::Vector2f& p_W) const {
-  return !marked_.empty() && marked_.count({FloorToInt(p_W.x() / geometry_.cell_size_m),
-                                            FloorToInt(p_W.y() / geometry_.cell_size_m)}) != 0;
+std::pair<int, int> FloorMap::GlobalCell(const Eigen::Vector2f& p_W) const {
+  return {FloorToInt(p_W.x() / geometry_.cell_size_m), FloorToInt(p_W.y() / geometry_.cell_size_m)};
+}
+
+std::vector<Eigen::Vector2f> FloorMap::MarkContacts(std::span<const Eigen::Vector2f> contacts_W) {
+  constexpr int kSeenCells = 2;
+  const float cell_m = geometry_.cell_size_m;
+  std::vector<Eigen::Vector2f> mark;
+  for (const Eigen::Vector2f& p : contacts_W) {
+    if (!p.allFinite()) continue;
+    bool beside_seen = false;
+    for (int dy = -kSeenCells; dy <= kSeenCells && !beside_seen; ++dy)
+      for (int dx = -kSeenCells; dx <= kSeenCells && !beside_seen; ++dx) {
+        const Eigen::Vector2f q = p + cell_m * Eigen::Vector2f(float(dx), float(dy));
+        beside_seen = AtPoint(q) == FloorCell::kObstacle && !marked_.count(GlobalCell(q));
+      }
+    if (!beside_seen || !contacts_beside_seen_.insert(GlobalCell(p)).second) mark.push_back(p);
+  }
+  if (mark.empty() || !MarkObstacles(mark)) return {};
+  return mark;
 }
 
 bool FloorMap::ApplyMarks(const std::vector<std::pair<int, int>>& cells) {

@@ -82,8 +82,11 @@ class FloorMap {
   // says: what a robot's bumper ran into, which its camera may never see (too low, or in the
   // blind zone in front of it). Grows the raster to cover them; true when a cell changed.
   bool MarkObstacles(std::span<const Eigen::Vector2f> points_W);
-  // Whether the cell holding p_W was marked by MarkObstacles.
-  bool Marked(const Eigen::Vector2f& p_W) const;
+  // A bumper's contacts (world xy) go on the map as MarkObstacles puts them, except one within
+  // two cells of an obstacle the volume put there: that is mostly the same obstacle a cell off on
+  // the map's grid, and marking it at once narrows doorways, so it goes on the map when it is
+  // reported a second time. Returns the contacts that changed the map (empty when none did).
+  std::vector<Eigen::Vector2f> MarkContacts(std::span<const Eigen::Vector2f> contacts_W);
 
   const FloorMapParams& params() const { return params_; }
   const FloorGeometry& geometry() const { return geometry_; }
@@ -110,6 +113,8 @@ class FloorMap {
   bool GrowToCover(const std::vector<Eigen::Vector2i>& block_columns);
   bool ProjectBlockColumn(const TsdfVolume& volume, Eigen::Vector2i block_column, float trunc_vox);
   bool UpdateFrontier(const std::vector<Eigen::Vector2i>& block_columns);
+  // The global cell (x, y) holding a world point, the key of the marks.
+  std::pair<int, int> GlobalCell(const Eigen::Vector2f& p_W) const;
   // Sets the marked global cells to obstacle (growing the raster), then their frontier rings.
   bool ApplyMarks(const std::vector<std::pair<int, int>>& cells);
 
@@ -119,7 +124,8 @@ class FloorMap {
   int required_free_ = 0;          // observed-free band voxels a cell needs
   FloorGeometry geometry_;
   std::vector<FloorCell> cells_;
-  std::set<std::pair<int, int>> marked_;  // global cells (x, y) of MarkObstacles
+  std::set<std::pair<int, int>> marked_;                // global cells (x, y) of MarkObstacles
+  std::set<std::pair<int, int>> contacts_beside_seen_;  // MarkContacts' first reports there
   uint64_t revision_ = 0;
 };
 

@@ -6,7 +6,6 @@
 #include <deque>
 #include <limits>
 #include <numbers>
-#include <set>
 #include <sstream>
 
 #include "core/queries.h"
@@ -115,7 +114,6 @@ class Explorer {
   std::unique_ptr<TsdfVolume> volume_;
   PlanningMap map_;
   std::unique_ptr<FloorMap> floor_;
-  std::set<std::pair<int, int>> wall_contacts_;  // floor cells bumped once beside a seen wall
   ExploreWorld explore_world_;
   std::vector<RobotRun> robots_;
   std::vector<BlockIndex> touched_;  // since the last floor-map update
@@ -225,33 +223,18 @@ void Explorer::Fail(RobotRun& r, const std::string& why) {
 }
 
 // The bumper: what a refused drive on the host's route ran into goes on the floor map as
-// obstacle, so the host's routes and the planner's raster avoid it. Without it a robot whose camera
-// never sees the obstacle (too low, or too close) is routed into it again and again. A contact
-// within two cells of an obstacle the camera put on the map is mostly that wall a cell off on the
-// map's grid: marking it at once narrowed a doorway (OMT on apartment M1 then sent its robots back
-// and forth through it for 1000 s), so such a cell is marked only when it is bumped a second time
-// (a robot wedged at a wall otherwise failed there 242 times, greedy on apartment M2).
+// obstacle (FloorMap::MarkContacts), so the host's routes and the planner's raster avoid it.
+// Without it a robot whose camera never sees the obstacle (too low, or too close) is routed into
+// it again and again.
 void Explorer::Bump(RobotRun& r, const Eigen::Vector2f& goal_W) {
   const Robot& robot = r.robot;
-  constexpr int kWallCells = 2;
-  const float cell_m = floor_->geometry().cell_size_m;
-  std::vector<Eigen::Vector2f> contact;
-  for (const Eigen::Vector2f& p :
-       FirstContact(robot.plan(), robot.state().position_W, goal_W, robot.params().radius_m)) {
-    bool known = false;
-    for (int dy = -kWallCells; dy <= kWallCells && !known; ++dy)
-      for (int dx = -kWallCells; dx <= kWallCells && !known; ++dx) {
-        const Eigen::Vector2f q = p + cell_m * Eigen::Vector2f(float(dx), float(dy));
-        known = floor_->AtPoint(q) == FloorCell::kObstacle && !floor_->Marked(q);
-      }
-    const std::pair<int, int> cell = {FloorToInt(p.x() / cell_m), FloorToInt(p.y() / cell_m)};
-    if (!known || !wall_contacts_.insert(cell).second) contact.push_back(p);
-  }
-  if (contact.empty() || !floor_->MarkObstacles(contact)) return;
+  const std::vector<Eigen::Vector2f> marked = floor_->MarkContacts(
+      FirstContact(robot.plan(), robot.state().position_W, goal_W, robot.params().radius_m));
+  if (marked.empty()) return;
   result_.plan_log.push_back("t=" + Fmt(r.t_s) + " robot " + std::to_string(r.index) +
-                             " bumped into " + std::to_string(contact.size()) +
-                             " floor cells near (" + Fmt(contact.front().x()) + ", " +
-                             Fmt(contact.front().y()) + "): marked as obstacles");
+                             " bumped into " + std::to_string(marked.size()) +
+                             " floor cells near (" + Fmt(marked.front().x()) + ", " +
+                             Fmt(marked.front().y()) + "): marked as obstacles");
 }
 
 // Straight shortcuts over the known raster: from each kept point, the farthest later point in

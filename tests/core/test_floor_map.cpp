@@ -396,6 +396,27 @@ TEST(FloorMap, MarkedObstaclesStayWhateverTheVolumeSays) {
   EXPECT_EQ(MapAt(map, 10, 40), FloorCell::kFree);  // the rest is as it was
 }
 
+TEST(FloorMap, ContactsBesideSeenWallsNeedASecondReport) {
+  // A bumper's contact two cells from the dividing wall the camera saw (x 20) is mostly that wall
+  // a cell off on the map's grid: it goes on the map only when reported again. One in the open
+  // goes on at once, and so do contacts beside cells only the bumper put there, or three cells
+  // from the seen wall.
+  FloorMap map = ProjectFloor(SharedLayout(), FloorMapParams{});
+  const std::vector<Eigen::Vector2f> beside = {Center(22, 10)};
+  ASSERT_EQ(MapAt(map, 22, 10), FloorCell::kFree);
+  EXPECT_TRUE(map.MarkContacts(beside).empty());
+  EXPECT_EQ(MapAt(map, 22, 10), FloorCell::kFree);
+  EXPECT_EQ(map.MarkContacts(beside).size(), 1u);
+  EXPECT_EQ(MapAt(map, 22, 10), FloorCell::kObstacle);
+  EXPECT_TRUE(map.MarkContacts(beside).empty());  // already there: nothing changes
+  for (const Eigen::Vector2i& c :
+       {Eigen::Vector2i(10, 40), Eigen::Vector2i(11, 40), Eigen::Vector2i(23, 12)}) {
+    const std::vector<Eigen::Vector2f> contact = {Center(c.x(), c.y())};
+    EXPECT_EQ(map.MarkContacts(contact).size(), 1u) << c.transpose();
+    EXPECT_EQ(MapAt(map, c.x(), c.y()), FloorCell::kObstacle) << c.transpose();
+  }
+}
+
 TEST(Geodesic, StraightLinesAreEuclidean) {
   const FloorMap map = ProjectFloor(SharedLayout(), FloorMapParams{});
   GeodesicCache cache;
