@@ -169,14 +169,16 @@ WorldInput ReadWorld(const vp::WorldView& world, const CommonOptions& options) {
       if (std::isfinite(mode.max_speed_mps) && mode.max_speed_mps > 0.f) {
         state.speed_mps = mode.max_speed_mps;
       }
+      // The narrowest field of view and the shortest range over the robots (0: none yet).
+      auto keep_smallest = [](double* smallest, float value) {
+        *smallest = *smallest > 0.0 ? std::min(*smallest, double(value)) : double(value);
+      };
       if (std::isfinite(mode.horizontal_fov_rad) && mode.horizontal_fov_rad > 0.f &&
           mode.horizontal_fov_rad < float(2.0 * omt::kPi)) {
-        in.fov_rad = in.fov_rad > 0.0 ? std::min(in.fov_rad, double(mode.horizontal_fov_rad))
-                                      : double(mode.horizontal_fov_rad);
+        keep_smallest(&in.fov_rad, mode.horizontal_fov_rad);
       }
       if (std::isfinite(mode.max_range_m) && mode.max_range_m > 0.f) {
-        in.range_m = in.range_m > 0.0 ? std::min(in.range_m, double(mode.max_range_m))
-                                      : double(mode.max_range_m);
+        keep_smallest(&in.range_m, mode.max_range_m);
       }
     }
     max_radius_m = std::max(max_radius_m, robot.radius_m);
