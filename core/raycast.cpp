@@ -587,7 +587,8 @@ struct Ray {
   float prev_z = 0.f;
   int16_t prev_tsdf = 0;
   size_t pixel = 0;
-  float z_restart = -1.f;  // >= 0: on a miss, march again from here (the cell's first block)
+  float z_skipped = -1.f;  // as RayTask's
+  float z_begin = 0.f;     // where the march began
   RayResult result;
 };
 
@@ -640,7 +641,9 @@ struct RayTask {
   size_t pixel;
   int u, v;
   float z_begin, z_end;
-  float z_restart;  // >= 0: on a miss, march again from here
+  // >= 0: [z_skipped, z_begin) was skipped (it holds no surface); marched as well when the march
+  // from z_begin meets no observed voxel, so that the status says whether the ray met any.
+  float z_skipped;
 };
 
 class RayCaster {
@@ -745,6 +748,12 @@ class RayCaster {
     }
     ray.result.status = RayStatus::kFree;  // at least: an observed voxel was met
     const int16_t tsdf = block->tsdf[i];
+    if (tsdf == 0 && ray.have_prev && ray.prev_tsdf > 0) {
+      // On the surface after a positive sample, which stays the crossing's start: a run of
+      // zeros along a grazing ray can end where the interpolant is well past its zero.
+      ray.z += ray.voxel_z;
+      return false;
+    }
     if (ray.have_prev && (ray.prev_tsdf >= 0) != (tsdf >= 0)) {
       if (tsdf >= 0) {  // back face: entered from behind a surface
         if (params_.stop_at_back_faces) return true;
@@ -772,7 +781,8 @@ class RayCaster {
       if (next == num_tasks) return false;
       const RayTask& task = tasks[next++];
       Start(Direction(task), task.z_begin, task.z_end, ray);
-      ray->z_restart = task.z_restart;
+      ray->z_skipped = task.z_skipped;
+      ray->z_begin = task.z_begin;
       ray->pixel = task.pixel;
       return true;
     };
@@ -783,12 +793,9 @@ class RayCaster {
     while (num_live > 0)
       for (int l = 0; l < kLanes; ++l) {
         if (!live[l] || !Step(rays[l])) continue;
-        if (rays[l].result.status != RayStatus::kHit && rays[l].z_restart >= 0.f) {
-          // A miss after skipping free space: march the whole range, so the status says
-          // whether the ray met observed space.
-          const float z_restart = rays[l].z_restart;
-          Start(rays[l].dir_W, z_restart, rays[l].z_end, &rays[l]);
-          rays[l].z_restart = -1.f;
+        if (rays[l].result.status == RayStatus::kUnobserved && rays[l].z_skipped >= 0.f) {
+          Start(rays[l].dir_W, rays[l].z_skipped, rays[l].z_begin, &rays[l]);
+          rays[l].z_skipped = -1.f;
           continue;
         }
         write(rays[l].pixel, rays[l].result, rays[l].dir_W);
@@ -815,13 +822,13 @@ class RayCaster {
           met[kPacketLanes];  // 0 or -1
       const TsdfBlock* block[kPacketLanes];
       size_t pixel[kPacketLanes];
-      float z_restart[kPacketLanes];
+      float z_skipped[kPacketLanes], z_begin[kPacketLanes];
     } lanes;
     std::memset(&lanes, 0, sizeof(lanes));
     for (auto& block : lanes.block) block = &kNoBlock;
     // Starts lane l's march of the ray through `pixel` from z_begin to z_end.
     auto start = [&](int l, const Eigen::Vector3f& dir_W, float z_begin, float z_end,
-                     float z_restart, size_t pixel) {
+                     float z_skipped, size_t pixel) {
       Ray ray;
       Start(dir_W, z_begin, z_end, &ray);
       const Eigen::Vector3f dir_vox = dir_W * sampler_.inv_voxel();  // as Start computes it
@@ -835,7 +842,7 @@ class RayCaster {
       lanes.live[l] = -1, lanes.has_block[l] = 0, lanes.have_prev[l] = 0, lanes.met[l] = 0;
       lanes.block[l] = &kNoBlock;
       lanes.pixel[l] = pixel;
-      lanes.z_restart[l] = z_restart;
+      lanes.z_skipped[l] = z_skipped, lanes.z_begin[l] = z_begin;
     };
     size_t next = 0;
     auto start_next = [&](int l) {
@@ -845,15 +852,15 @@ class RayCaster {
         return false;
       }
       const RayTask& task = tasks[next++];
-      start(l, Direction(task), task.z_begin, task.z_end, task.z_restart, task.pixel);
+      start(l, Direction(task), task.z_begin, task.z_end, task.z_skipped, task.pixel);
       return true;
     };
-    // Lane l's ray ended with `result`: march the whole range again when it skipped free space
-    // and did not hit (so the status says whether it met observed space), else write it and
-    // start the next ray. False when the lane is left without a ray.
+    // Lane l's ray ended with `result`: march the range it skipped when it met nothing observed
+    // (as MarchInterleaved does), else write it and start the next ray. False when the lane is
+    // left without a ray.
     auto finish = [&](int l, const Eigen::Vector3f& dir_W, const RayResult& result) {
-      if (result.status != RayStatus::kHit && lanes.z_restart[l] >= 0.f) {
-        start(l, dir_W, lanes.z_restart[l], lanes.z_end[l], -1.f, lanes.pixel[l]);
+      if (result.status == RayStatus::kUnobserved && lanes.z_skipped[l] >= 0.f) {
+        start(l, dir_W, lanes.z_skipped[l], lanes.z_begin[l], -1.f, lanes.pixel[l]);
         return true;
       }
       write(lanes.pixel[l], result, dir_W);
@@ -921,10 +928,14 @@ class RayCaster {
         const __m256i cross = _mm256_and_si256(
             _mm256_and_si256(observed, have_prev),
             _mm256_xor_si256(_mm256_cmpgt_epi32(prev_tsdf, minus_one), tsdf_nonneg));
+        // A zero after a positive sample: one voxel on, the positive one kept (as Step does).
+        const __m256i on_surface = _mm256_and_si256(
+            _mm256_and_si256(observed, have_prev),
+            _mm256_and_si256(_mm256_cmpeq_epi32(tsdf, zero), _mm256_cmpgt_epi32(prev_tsdf, zero)));
         const __m256i back_face = _mm256_and_si256(cross, tsdf_nonneg);
         const __m256i stop = _mm256_and_si256(back_face, stop_at_back_faces);
         const __m256i front_face = avx2::AndNot(tsdf_nonneg, cross);  // refined below
-        const __m256i advance = avx2::AndNot(cross, observed);
+        const __m256i advance = avx2::AndNot(_mm256_or_si256(cross, on_surface), observed);
         const __m256i one_voxel = _mm256_or_si256(unobserved, avx2::AndNot(stop, back_face));
 
         // Where a lane without a block leaves it (nudged past the face).
@@ -946,7 +957,7 @@ class RayCaster {
             z_next,
             _mm256_add_ps(_mm256_max_ps(z, z_exit), _mm256_mul_ps(_mm256_set1_ps(0.01f), voxel_z)),
             no_block);
-        z_next = avx2::Blend(z_next, _mm256_add_ps(z, voxel_z), one_voxel);
+        z_next = avx2::Blend(z_next, _mm256_add_ps(z, voxel_z), _mm256_or_si256(one_voxel, on_surface));
         z_next = avx2::Blend(
             z_next,
             _mm256_add_ps(
@@ -957,7 +968,8 @@ class RayCaster {
                          avx2::Blend(avx2::LoadF(lanes.prev_z + base), z, advance));
         avx2::Store(lanes.prev_tsdf + base, _mm256_blendv_epi8(prev_tsdf, tsdf, advance));
         avx2::Store(lanes.tsdf + base, tsdf);
-        // have_prev: set by an advance, cleared by a jump or a one-voxel step, kept otherwise.
+        // have_prev: set by an advance, cleared by a jump or a one-voxel step, kept otherwise (on
+        // the surface too).
         const __m256i cleared = _mm256_or_si256(no_block, one_voxel);
         avx2::Store(lanes.have_prev + base,
                     _mm256_or_si256(advance, avx2::AndNot(cleared, have_prev)));
