@@ -957,7 +957,8 @@ class RayCaster {
             z_next,
             _mm256_add_ps(_mm256_max_ps(z, z_exit), _mm256_mul_ps(_mm256_set1_ps(0.01f), voxel_z)),
             no_block);
-        z_next = avx2::Blend(z_next, _mm256_add_ps(z, voxel_z), _mm256_or_si256(one_voxel, on_surface));
+        z_next =
+            avx2::Blend(z_next, _mm256_add_ps(z, voxel_z), _mm256_or_si256(one_voxel, on_surface));
         z_next = avx2::Blend(
             z_next,
             _mm256_add_ps(
