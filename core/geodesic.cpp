@@ -126,7 +126,7 @@ Image<float> ComputeClearance(const FloorMap& map, bool unknown_is_obstacle) {
   const float cell = map.cell_size_m();
   for (int iy = 0; iy < h; ++iy)
     for (int ix = 0; ix < w; ++ix)
-      clearance.at(ix, iy) = FootprintClearance(d2.at(ix + pad, iy + pad), cell);
+      clearance.at(ix, iy) = std::sqrt(d2.at(ix + pad, iy + pad)) * cell;
   return clearance;
 }
 

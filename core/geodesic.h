@@ -5,10 +5,7 @@
 // such shortest distances on the floor). All distances in metres, between cell centres;
 // unreachable is +inf.
 #include <Eigen/Core>
-#include <algorithm>
-#include <cmath>
 #include <cstdint>
-#include <limits>
 #include <map>
 #include <memory>
 #include <optional>
@@ -25,19 +22,8 @@ namespace voxplan {
 // sites.at(x, y) != 0; +inf when there is none. Exact (Felzenszwalb & Huttenlocher 2012).
 Image<float> SquaredDistanceTransform(const Image<uint8_t>& sites);
 
-// The room a robot centred on a cell has before it touches an obstacle cell anywhere on its
-// square: the distance to the nearest obstacle cell centre (squared, in cells^2, as
-// SquaredDistanceTransform gives it) less half a cell diagonal, in metres; 0 on obstacles, +inf
-// when there are none. A bound from below, so that a robot whose radius is
-// within it does not touch a wall the map shows (the centre distance alone let a route graze
-// a corner by up to a third of a cell, which the robot then could not drive).
-inline float FootprintClearance(float squared_cells, float cell_size_m) {
-  if (!(squared_cells < std::numeric_limits<float>::infinity()))
-    return std::numeric_limits<float>::infinity();
-  return std::max(std::sqrt(squared_cells) - 0.70710678f, 0.f) * cell_size_m;
-}
-
-// FootprintClearance of each cell, indexed like the raster (at(ix, iy)). With
+// Distance in metres from each cell centre to the nearest obstacle cell centre, indexed like
+// the raster (at(ix, iy)): 0 on obstacles, +inf when there are none. With
 // `unknown_is_obstacle`, unknown cells and everything outside the raster count as obstacles.
 Image<float> ComputeClearance(const FloorMap& map, bool unknown_is_obstacle = false);
 

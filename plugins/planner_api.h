@@ -164,10 +164,8 @@ typedef struct vp_floor {
   float cell_size_m;
   float origin_x_m, origin_y_m;
   uint64_t revision;
-  const uint8_t* cells; /* VP_FLOOR_*, width * height */
-  /* Room from the cell centre to the nearest obstacle cell's square (the distance to its centre
-   * less half a cell diagonal): a robot of a radius within it touches no known obstacle. */
-  const float* clearance_m;
+  const uint8_t* cells;     /* VP_FLOOR_*, width * height */
+  const float* clearance_m; /* distance from the cell centre to the nearest obstacle */
 } vp_floor;
 
 /* What a scanning mode changes (Guo 2022): speed and the camera's view. */

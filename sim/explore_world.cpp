@@ -79,7 +79,7 @@ void ExploreWorld::Refresh() {
   const Image<float> d2 = SquaredDistanceTransform(sites);
   pf.clearance_m.resize(pf.cells.size());
   for (size_t i = 0; i < pf.cells.size(); ++i)
-    pf.clearance_m[i] = FootprintClearance(d2.data[i], pf.cell_size_m);
+    pf.clearance_m[i] = std::isfinite(d2.data[i]) ? std::sqrt(d2.data[i]) * pf.cell_size_m : kInf;
   ++pf.revision;  // a new raster for the planner whenever either input changed
   floor_revision_ = f.revision();
   footprint_changed_ = false;
