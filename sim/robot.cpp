@@ -98,7 +98,12 @@ bool VisitBlocked(const FloorPlan& plan, const Eigen::Vector2f& p_W, float radiu
       (p_W - plan.origin_W) / res + Eigen::Vector2f::Constant(radius_m / res);
   const int x0 = int(std::floor(lo.x() - 0.5f)), x1 = int(std::ceil(hi.x() - 0.5f));
   const int y0 = int(std::floor(lo.y() - 0.5f)), y1 = int(std::ceil(hi.y() - 0.5f));
-  const float r2 = radius_m * radius_m;
+  // A cell centre at the radius itself touches, it does not block: the host measures clearance
+  // between cell centres and routes at exactly the radius where it must (the map's and the
+  // plan's centres then lie the radius apart, give or take float rounding, absorbed here).
+  constexpr float kTouch_m = 1e-4f;
+  const float reach_m = std::max(radius_m - kTouch_m, 0.f);
+  const float r2 = reach_m * reach_m;
   bool any = false, free = true;
   for (int y = y0; y <= y1; ++y)
     for (int x = x0; x <= x1; ++x) {

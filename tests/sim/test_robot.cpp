@@ -41,9 +41,13 @@ TEST(Robot, FootprintAgainstFloorPlan) {
   const FloorPlan plan = SquareWithPillar();
   const float r = 0.2f;
   EXPECT_TRUE(FootprintFree(plan, {0.6f, 0.6f}, r));
-  EXPECT_FALSE(FootprintFree(plan, {2.0f, 2.0f}, r));   // inside the pillar
-  EXPECT_FALSE(FootprintFree(plan, {1.4f, 2.0f}, r));   // 0.1 m from the pillar
-  EXPECT_TRUE(FootprintFree(plan, {1.2f, 2.0f}, r));    // 0.3 m from it
+  EXPECT_FALSE(FootprintFree(plan, {2.0f, 2.0f}, r));  // inside the pillar
+  EXPECT_FALSE(FootprintFree(plan, {1.4f, 2.0f}, r));  // 0.1 m from the pillar
+  EXPECT_TRUE(FootprintFree(plan, {1.2f, 2.0f}, r));   // 0.3 m from it
+  // Exactly the radius from the nearest pillar cell's centre (1.525, 2.025), as a host route
+  // at the clearance limit runs: touching, not blocked; a centimetre closer is.
+  EXPECT_TRUE(FootprintFree(plan, {1.325f, 2.025f}, r));
+  EXPECT_FALSE(FootprintFree(plan, {1.335f, 2.025f}, r));
   EXPECT_FALSE(FootprintFree(plan, {0.15f, 1.0f}, r));  // against the outer wall
   EXPECT_FALSE(FootprintFree(plan, {-1.f, 1.0f}, r));   // off the plan
   EXPECT_TRUE(SegmentFree(plan, {0.6f, 0.6f}, {3.4f, 0.6f}, r));
