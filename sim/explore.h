@@ -10,11 +10,12 @@
 // it in short segments at the mode's speed with Robot::DriveTo, which refuses segments that hit
 // the *true* floor plan (a plugin path that does is replaced once by the host's route; then
 // the task fails: kTaskFailed). A refused segment of the host's route is a bumper's contact:
-// the plan cells it ran into become obstacles of the floor map (FloorMap::MarkObstacles), for
-// the host's routes and the planner's raster alike; the camera looks along the motion unless the
-// plugin gave a camera trajectory; at the view it turns base and camera to the task's angles,
-// dwells and captures. Base turns, camera joints and driving take their time one after the other. A
-// frame is fused whenever the FusionTrigger fires, and at every view.
+// the plan cells it ran into become obstacles of the floor map (FloorMap::MarkContacts: beside
+// a wall the map shows, at the second report), for the host's routes and the planner's raster
+// alike. The camera looks along the motion unless the plugin gave a camera trajectory; at the
+// view it turns base and camera to the task's angles, dwells and captures. Base turns, camera
+// joints and driving take their time one after the other. A frame is fused whenever the
+// FusionTrigger fires, and at every view.
 // Events: kStart after an initial camera sweep, kInterval every planning interval without a
 // call, kRobotIdle when a robot's queue empties, kTaskFailed. Robot collisions with each other
 // are not simulated (as in Dong 2019).

@@ -114,10 +114,9 @@ void EmitViews(const vp::WorldView& world, vp::PlanOutput& out, const BaselineWo
     tasks.push_back(TaskFromView(b.views[size_t(k)], path[i].theta_rad, robot, dwell_s));
     out.AddTask(r, tasks.back());
   }
-  settled->Sent(r, tasks);
   std::vector<int> taken;
   for (const auto& [k, i] : arrivals) taken.push_back(k);
-  settled->Remember(r, b.input.raster.geometry, b.views, taken);
+  settled->Sent(r, tasks, b.input.raster.geometry, b.views, taken);
   if (arrivals.empty()) return;
   if (path.size() < 2) return;  // already standing at its one view
   out.SetPath(r, path);

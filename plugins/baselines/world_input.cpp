@@ -288,22 +288,14 @@ bool SettledCells::TookItsView(uint32_t r, const vp_robot& robot) const {
          (Eigen::Vector2f(robot.x_m, robot.y_m) - goal->second).norm() <= kAtGoalM;
 }
 
-void SettledCells::Sent(uint32_t r, std::span<const vp_task> tasks) {
+void SettledCells::Sent(uint32_t r, std::span<const vp_task> tasks, const omt::RasterGeometry& g,
+                        const std::vector<omt::TaskView>& views, const std::vector<int>& ids) {
   if (tasks.empty()) {
     goal_.erase(r);  // it stops and looks where it stands; a stalled robot stays stalled
-    return;
+  } else {
+    goal_[r] = {tasks.back().x_m, tasks.back().y_m};
+    stalled_.erase(r);
   }
-  goal_[r] = {tasks.back().x_m, tasks.back().y_m};
-  stalled_.erase(r);
-}
-
-SettledCells::Key SettledCells::KeyOf(const omt::RasterGeometry& g, int cell) const {
-  const Eigen::Vector2d c = g.Center(cell) / g.resolution_m;
-  return {long(std::floor(c.x())), long(std::floor(c.y()))};
-}
-
-void SettledCells::Remember(uint32_t r, const omt::RasterGeometry& g,
-                            const std::vector<omt::TaskView>& views, const std::vector<int>& ids) {
   std::vector<Key>& keys = given_[r];
   keys.clear();
   for (int id : ids) {
@@ -311,6 +303,11 @@ void SettledCells::Remember(uint32_t r, const omt::RasterGeometry& g,
     if (cell >= 0 && cell < g.NumCells()) keys.push_back(KeyOf(g, cell));
   }
   if (keys.empty()) given_.erase(r);
+}
+
+SettledCells::Key SettledCells::KeyOf(const omt::RasterGeometry& g, int cell) const {
+  const Eigen::Vector2d c = g.Center(cell) / g.resolution_m;
+  return {long(std::floor(c.x())), long(std::floor(c.y()))};
 }
 
 void SettledCells::Apply(const vp::WorldView& world, const omt::PlannerOptions& options,

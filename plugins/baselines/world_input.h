@@ -107,15 +107,14 @@ class SettledCells {
   std::vector<uint8_t> Mask(const omt::RasterGeometry& g) const;
   size_t size() const { return cells_.size(); }
 
-  // The target cells of the views robot r was just given (ids into views, over raster g). When
-  // r is next idle it has taken them: a target taken kRepeatLimit times whose view still comes
-  // back is settled, with every cell of r's fan up to the first surface, whatever its
-  // uncertainty (a surface whose weight never rises would otherwise hold its view forever).
-  void Remember(uint32_t r, const omt::RasterGeometry& g, const std::vector<omt::TaskView>& views,
-                const std::vector<int>& ids);
+  // Robot r's queue was just replaced by `tasks` (none: told to stop where it is), the task
+  // views views[ids] over raster g. When r is next idle at the last of them it has taken their
+  // targets: a target taken kRepeatLimit times whose view still comes back is settled, with
+  // every cell of r's fan up to the first surface, whatever its uncertainty (a surface whose
+  // weight never rises would otherwise hold its view forever).
+  void Sent(uint32_t r, std::span<const vp_task> tasks, const omt::RasterGeometry& g,
+            const std::vector<omt::TaskView>& views, const std::vector<int>& ids);
   static constexpr int kRepeatLimit = 2;
-  // Robot r's queue was just replaced by `tasks` (none: told to stop where it is).
-  void Sent(uint32_t r, std::span<const vp_task> tasks);
 
  private:
   using Key = std::pair<long, long>;  // global cell (floor(x / res), floor(y / res))

@@ -74,8 +74,8 @@ class OmtPlanner : public vp::Planner {
     }
     vp::StageTimer timer(world, out, "output");
     for (uint32_t r = 0; r < in.robots.size(); ++r) {
-      settled_.Sent(r, Emit(in, result, r, out));
-      settled_.Remember(r, in.raster.geometry, result.views, result.robots[r].tasks);
+      settled_.Sent(r, Emit(in, result, r, out), in.raster.geometry, result.views,
+                    result.robots[r].tasks);
     }
   }
 

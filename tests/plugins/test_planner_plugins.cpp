@@ -255,17 +255,24 @@ TEST(Planners, NotDoneWhileNoRobotStandsOnKnownFreeSpace) {
   }
 }
 
+// A scanned 4 x 2 m room whose walls never gain weight, with unknown cells [x0, x1] x [y0, y1],
+// and one robot at cell (10, 20) heading theta_rad.
+test::RasterWorld RoomWithPocket(int x0, int y0, int x1, int y1, float theta_rad) {
+  test::RasterWorld world(80, 40, 0.05f);
+  world.Walls();
+  world.Fill(x0, y0, x1, y1, FloorCell::kUnknown);
+  world.Finish();
+  world.set_surface_weight(1000.f);
+  world.AddRobot(10, 20, 0.18f).theta_rad = theta_rad;
+  return world;
+}
+
 TEST(Planners, DoneOnceAnIdleRobotLookedAtWhatStaysUnknown) {
   // A scanned room with an unknown pocket 2 m ahead of an idle robot: facing it, the robot has
   // looked at it from within range and it stayed unknown (the sensor cannot resolve it from
   // there), so nothing is worth a view; facing away, the pocket still is.
   for (const float theta : {0.f, 3.1416f}) {
-    test::RasterWorld world(80, 40, 0.05f);
-    world.Walls();
-    world.Fill(50, 15, 55, 25, FloorCell::kUnknown);
-    world.Finish();
-    world.set_surface_weight(1000.f);
-    world.AddRobot(10, 20, 0.18f).theta_rad = theta;
+    test::RasterWorld world = RoomWithPocket(50, 15, 55, 25, theta);
     for (const std::string& name : kPlanners) {
       auto planner = MustLoad(name);
       ASSERT_TRUE(planner);
@@ -282,13 +289,8 @@ TEST(Planners, AFailedTaskSettlesNothingUntilTheRobotTakesAView) {
   // the failure call nor a later idle call may settle the pocket (it would end the run with the
   // pocket unseen); once the robot stands at a view it was sent to after the failure, it may.
   for (const std::string& name : kPlanners) {
-    test::RasterWorld world(80, 40, 0.05f);
-    world.Walls();
-    world.Fill(50, 15, 55, 25, FloorCell::kUnknown);
-    world.Finish();
-    world.set_surface_weight(1000.f);
-    PlannerRobot& robot = world.AddRobot(10, 20, 0.18f);
-    robot.theta_rad = 3.1416f;  // facing away: the start settles nothing of the pocket
+    // Facing away: the start settles nothing of the pocket.
+    test::RasterWorld world = RoomWithPocket(50, 15, 55, 25, 3.1416f);
     auto planner = MustLoad(name);
     ASSERT_TRUE(planner);
     const PlanResult start = MustPlan(*planner, world);
@@ -352,14 +354,9 @@ TEST(Planners, ImportanceThresholdScalesWithWhatTheCameraSees) {
   // are done; above it for a camera half as wide (bar 0.75), which still sends a robot there.
   for (const std::string& name : kPlanners) {
     for (const double fov_deg : {90.0, 29.0}) {
-      test::RasterWorld world(80, 40, 0.05f);
-      world.Walls();
-      world.Fill(50, 20, 51, 21, FloorCell::kUnknown);
-      world.Finish();
-      world.set_surface_weight(1000.f);
-      PlannerRobot& robot = world.AddRobot(10, 20, 0.18f);
-      robot.theta_rad = 3.1416f;  // facing away: its first look settles nothing of the pocket
-      robot.modes[0].horizontal_fov_rad = float(fov_deg * deg);
+      // Facing away: its first look settles nothing of the pocket.
+      test::RasterWorld world = RoomWithPocket(50, 20, 51, 21, 3.1416f);
+      world.robots()[0].modes[0].horizontal_fov_rad = float(fov_deg * deg);
       auto planner = MustLoad(name);
       ASSERT_TRUE(planner);
       const PlanResult r = MustPlan(*planner, world);
