@@ -464,45 +464,51 @@ class Sampler {
     return GatherRest(cell);
   }
 
+  // The blocks and voxel indices of the corners of the cell whose corner 0 is g, for a cell
+  // across block faces. Only the neighbours the corners reach are looked up (two usually);
+  // corner k lies in neighbour k & across, a missing block reads as never observed (kNoBlock).
+  void CornersAcross(GlobalVoxelIndex g, const TsdfBlock* block[8], int index[8]) {
+    const VoxelIndex local = LocalOf(g);
+    const BlockIndex b0 = BlockOf(g);
+    const bool ex = local.x == kBlockMask, ey = local.y == kBlockMask, ez = local.z == kBlockMask;
+    const int across = int(ex) | int(ey) << 1 | int(ez) << 2;
+    const TsdfBlock* neighbour[8];
+    // The neighbours bypass the last-block shortcut, which keeps b0 for the next gather.
+    auto find = [&](int dx, int dy, int dz) {
+      const TsdfBlock* block = cache_.Find(BlockIndex{b0.x + dx, b0.y + dy, b0.z + dz});
+      return block ? block : &kNoBlock;
+    };
+    const TsdfBlock* block0 = Find(b0);
+    neighbour[0] = block0 ? block0 : &kNoBlock;
+    if (ex) neighbour[1] = find(1, 0, 0);
+    if (ey) neighbour[2] = find(0, 1, 0);
+    if (ex && ey) neighbour[3] = find(1, 1, 0);
+    if (ez) {
+      neighbour[4] = find(0, 0, 1);
+      if (ex) neighbour[5] = find(1, 0, 1);
+      if (ey) neighbour[6] = find(0, 1, 1);
+      if (ex && ey) neighbour[7] = find(1, 1, 1);
+    }
+    // One voxel further along each axis: the next voxel in the block, or the first one of the
+    // neighbour (wrapped).
+    const int step_x = ex ? 1 - kBlockSide : 1;
+    const int step_y = (ey ? 1 - kBlockSide : 1) * kBlockSide;
+    const int step_z = (ez ? 1 - kBlockSide : 1) * kBlockSide * kBlockSide;
+    const int i0 = LinearIndex(local);
+    for (int k = 0; k < 8; ++k) {
+      block[k] = neighbour[k & across];
+      index[k] = i0 + (k & 1 ? step_x : 0) + (k & 2 ? step_y : 0) + (k & 4 ? step_z : 0);
+    }
+  }
+
   // Gather's other cases, out of line: corners across block faces, unobserved corners.
   [[gnu::noinline]] bool GatherRest(Cell* cell) {
     const GlobalVoxelIndex g{cell->base[0], cell->base[1], cell->base[2]};
     const VoxelIndex local = LocalOf(g);
-    const BlockIndex b0 = BlockOf(g);
     unsigned observed = cell->observed;  // set by Gather in one block
     if (!(local.x < kBlockMask && local.y < kBlockMask && local.z < kBlockMask)) {
-      // Corners across block faces: look up only the neighbours they reach (two usually);
-      // corner k lies in neighbour k & across, a missing block reads as never observed.
-      const bool ex = local.x == kBlockMask, ey = local.y == kBlockMask, ez = local.z == kBlockMask;
-      const int across = int(ex) | int(ey) << 1 | int(ez) << 2;
-      const TsdfBlock* neighbour[8];
-      // The neighbours bypass the last-block shortcut, which keeps b0 for the next gather.
-      auto find = [&](int dx, int dy, int dz) {
-        const TsdfBlock* block = cache_.Find(BlockIndex{b0.x + dx, b0.y + dy, b0.z + dz});
-        return block ? block : &kNoBlock;
-      };
-      const TsdfBlock* block0 = Find(b0);
-      neighbour[0] = block0 ? block0 : &kNoBlock;
-      if (ex) neighbour[1] = find(1, 0, 0);
-      if (ey) neighbour[2] = find(0, 1, 0);
-      if (ex && ey) neighbour[3] = find(1, 1, 0);
-      if (ez) {
-        neighbour[4] = find(0, 0, 1);
-        if (ex) neighbour[5] = find(1, 0, 1);
-        if (ey) neighbour[6] = find(0, 1, 1);
-        if (ex && ey) neighbour[7] = find(1, 1, 1);
-      }
-      // One voxel further along each axis: the next voxel in the block, or the first one of
-      // the neighbour (wrapped).
-      const int step_x = ex ? 1 - kBlockSide : 1;
-      const int step_y = (ey ? 1 - kBlockSide : 1) * kBlockSide;
-      const int step_z = (ez ? 1 - kBlockSide : 1) * kBlockSide * kBlockSide;
-      const int i0 = LinearIndex(local);
       cell->one_block = false;
-      for (int k = 0; k < 8; ++k) {
-        cell->block[k] = neighbour[k & across];
-        cell->index[k] = i0 + (k & 1 ? step_x : 0) + (k & 2 ? step_y : 0) + (k & 4 ? step_z : 0);
-      }
+      CornersAcross(g, cell->block, cell->index);
       observed = raycast_detail::LoadCornersAcross(cell->block, cell->index, min_weight_fixed_,
                                                    cell->tsdf);
     }
@@ -599,6 +605,21 @@ VOXPLAN_TARGET_AVX2 inline __m256i Load(const void* p) {
   return _mm256_loadu_si256(static_cast<const __m256i*>(p));
 }
 VOXPLAN_TARGET_AVX2 inline __m256 LoadF(const float* p) { return _mm256_loadu_ps(p); }
+VOXPLAN_TARGET_AVX2 inline __m256 Set(float x) { return _mm256_set1_ps(x); }
+// DecodeTsdf of each lane.
+VOXPLAN_TARGET_AVX2 inline __m256 Decode(__m256i t) {
+  return _mm256_mul_ps(_mm256_cvtepi32_ps(t), _mm256_set1_ps(1.0f / kTsdfScale));
+}
+// A trilinear weight as the SSE2 kernels form it: f where `upper`, 1 - f otherwise, each as
+// a + b f (the same roundings).
+VOXPLAN_TARGET_AVX2 inline __m256 Lerp(bool upper, __m256 f) {
+  return _mm256_add_ps(_mm256_set1_ps(upper ? 0.f : 1.f),
+                       _mm256_mul_ps(_mm256_set1_ps(upper ? 1.f : -1.f), f));
+}
+// (v0 + v1) + (v2 + v3): a transposed SSE2 horizontal sum, lane by lane.
+VOXPLAN_TARGET_AVX2 inline __m256 Sum4(const __m256 v[4]) {
+  return _mm256_add_ps(_mm256_add_ps(v[0], v[1]), _mm256_add_ps(v[2], v[3]));
+}
 VOXPLAN_TARGET_AVX2 inline void Store(void* p, __m256i v) {
   _mm256_storeu_si256(static_cast<__m256i*>(p), v);
 }
@@ -807,9 +828,10 @@ class RayCaster {
   // The same march over packets of kPacket rays in AVX2 lanes: every lane takes the sample Step
   // would take, with the same float operations in the same order (no FMA: the file is built
   // with -ffp-contract=off), so the images are identical to MarchInterleaved's. The steps have
-  // no per-ray branch; block lookups, crossings (Refine, scalar: gathering its cells lane by
-  // lane measured no faster on AVX2) and new rays are handled lane by lane. A worker marches
-  // kPackets packets in turn, so that one packet's gathers and lookups overlap another's.
+  // no per-ray branch; block lookups and new rays are handled lane by lane. A lane that meets a
+  // crossing hands it on and takes the next ray: crossings are refined kPacket at a time
+  // (RefineCrossings). A worker marches kPackets packets in turn, so that one packet's gathers
+  // and lookups overlap another's.
   template <class Write>
   VOXPLAN_TARGET_AVX2 void MarchPackets(const RayTask* tasks, size_t num_tasks, Write&& write) {
     struct alignas(32) Lanes {
@@ -844,16 +866,47 @@ class RayCaster {
       lanes.pixel[l] = pixel;
       lanes.z_skipped[l] = z_skipped, lanes.z_begin[l] = z_begin;
     };
+    // Crossings wait for refinement in `crossings`; a ray whose crossing had no zero resumes
+    // its march from there once a lane is free, as if it had never stopped.
+    Crossings crossings;
+    std::vector<Resume>& resumes = resumes_;
+    resumes.clear();
     size_t next = 0;
     auto start_next = [&](int l) {
-      if (next == num_tasks) {
-        lanes.live[l] = 0;
-        lanes.block[l] = &kNoBlock;
-        return false;
+      if (next < num_tasks) {
+        const RayTask& task = tasks[next++];
+        start(l, Direction(task), task.z_begin, task.z_end, task.z_skipped, task.pixel);
+        return true;
       }
-      const RayTask& task = tasks[next++];
-      start(l, Direction(task), task.z_begin, task.z_end, task.z_skipped, task.pixel);
-      return true;
+      if (!resumes.empty()) {
+        const Resume r = resumes.back();
+        resumes.pop_back();
+        start(l, r.dir_W, r.z_b, r.z_end, -1.f, r.pixel);
+        // The state Step leaves after a crossing without a zero: the negative sample is the
+        // previous one, one step on.
+        lanes.have_prev[l] = -1, lanes.met[l] = -1;
+        lanes.prev_z[l] = r.z_b;
+        lanes.prev_tsdf[l] = r.tsdf_b;
+        lanes.z[l] = r.z_b + std::max(float(r.tsdf_b) * lanes.step_z[l], lanes.voxel_z[l]);
+        return true;
+      }
+      lanes.live[l] = 0;
+      lanes.block[l] = &kNoBlock;
+      return false;
+    };
+    auto refine = [&] {
+      RayResult results[kPacket];
+      const unsigned found = RefineCrossings(crossings, results);
+      for (int j = 0; j < crossings.count; ++j) {
+        const Eigen::Vector3f dir_W(crossings.dir_W[0][j], crossings.dir_W[1][j],
+                                    crossings.dir_W[2][j]);
+        if ((found >> j) & 1)
+          write(crossings.pixel[j], results[j], dir_W);
+        else
+          resumes.push_back({dir_W, crossings.z_b[j], crossings.z_end[j],
+                             int16_t(crossings.tsdf_b[j]), crossings.pixel[j]});
+      }
+      crossings.count = 0;
     };
     // Lane l's ray ended with `result`: march the range it skipped when it met nothing observed
     // (as MarchInterleaved does), else write it and start the next ray. False when the lane is
@@ -880,7 +933,12 @@ class RayCaster {
         _mm256_set1_epi32(int32_t(sampler_.min_weight_fixed()) - 1);
     const __m256i stop_at_back_faces = params_.stop_at_back_faces ? minus_one : zero;
 
-    while (num_live > 0) {
+    while (num_live > 0 || crossings.count > 0) {
+      if (num_live == 0) {  // the last crossings, then the rays they resume
+        refine();
+        for (int l = 0; l < kPacketLanes; ++l) num_live += start_next(l);
+        continue;
+      }
       for (int base = 0; base < kPacketLanes; base += kPacket) {  // lanes [base, base + 8)
         const __m256i live = avx2::Load(lanes.live + base);
         const __m256 z = avx2::LoadF(lanes.z + base);
@@ -981,20 +1039,23 @@ class RayCaster {
         const int front_bits = _mm256_movemask_ps(_mm256_castsi256_ps(front_face));
         for (int bits = _mm256_movemask_ps(_mm256_castsi256_ps(done)); bits; bits &= bits - 1) {
           const int l = base + std::countr_zero(unsigned(bits));
+          if ((front_bits >> (l - base)) & 1) {
+            // A crossing: queued for refinement, and the lane takes the next ray.
+            const int j = crossings.count++;
+            for (int a = 0; a < 3; ++a) crossings.dir_W[a][j] = lanes.dir_W[a][l];
+            crossings.z_a[j] = lanes.prev_z[l], crossings.z_b[j] = lanes.z[l];
+            crossings.tsdf_a[j] = lanes.prev_tsdf[l], crossings.tsdf_b[j] = lanes.tsdf[l];
+            crossings.voxel_z[j] = lanes.voxel_z[l], crossings.z_end[j] = lanes.z_end[l];
+            crossings.pixel[j] = lanes.pixel[l];
+            for (int a = 0; a < 3; ++a) crossings.block_index[a][j] = lanes.block_index[a][l];
+            crossings.block[j] = lanes.block[l];
+            if (crossings.count == kPacket) refine();
+            num_live -= !start_next(l);
+            continue;
+          }
           const Eigen::Vector3f dir_W(lanes.dir_W[0][l], lanes.dir_W[1][l], lanes.dir_W[2][l]);
           RayResult result;
           if (lanes.met[l]) result.status = RayStatus::kFree;
-          if (((front_bits >> (l - base)) & 1) &&
-              !Cross(dir_W, lanes.prev_z[l], lanes.z[l], int16_t(lanes.prev_tsdf[l]),
-                     int16_t(lanes.tsdf[l]), lanes.voxel_z[l], &result)) {
-            // The nearest values disagree with the interpolant (noise): march on, as Step does.
-            const int16_t tsdf = int16_t(lanes.tsdf[l]);
-            lanes.have_prev[l] = -1;
-            lanes.prev_z[l] = lanes.z[l];
-            lanes.prev_tsdf[l] = tsdf;
-            lanes.z[l] += std::max(float(tsdf) * lanes.step_z[l], lanes.voxel_z[l]);
-            continue;
-          }
           num_live -= !finish(l, dir_W, result);
         }
       }
@@ -1015,9 +1076,10 @@ class RayCaster {
   // Finds the zero of the trilinear interpolant: Newton steps from the linear guess (the cell
   // gradient comes with the values, and the second step usually reuses the cell), else a
   // bracket moved until it straddles a zero and narrowed by regula falsi. Returns false when
-  // the interpolant has no zero here.
+  // the interpolant has no zero here. Without `newton`, straight to the bracket: for a caller
+  // whose Newton steps (the same as these) left their path.
   bool Refine(const Eigen::Vector3f& dir_W, float z_a, float z_b, float nearest_a, float nearest_b,
-              float voxel_z, RayResult* result) {
+              float voxel_z, RayResult* result, bool newton = true) {
     Cell cell;
     const float z_guess = z_a + (z_b - z_a) * nearest_a / (nearest_a - nearest_b);
     // The slope of the normalised TSDF along the ray must be clearly negative: a head-on ray
@@ -1027,7 +1089,7 @@ class RayCaster {
     float z = z_guess;
     Eigen::Vector3f gradient;
     bool converged = false;
-    for (int k = 0; k < kNewtonIterations; ++k) {
+    for (int k = 0; newton && k < kNewtonIterations; ++k) {
       float f = 0.f;
       if (!Sample(dir_W, z, &cell, &f, &gradient)) break;
       const float slope = gradient.dot(dir_W) * dq_dz;  // per metre of z
@@ -1097,8 +1159,8 @@ class RayCaster {
   // the refined hit (or kFree when it lies outside the depth limits), false when the
   // interpolant has no zero there.
   bool Cross(const Eigen::Vector3f& dir_W, float z_a, float z_b, int16_t tsdf_a, int16_t tsdf_b,
-             float voxel_z, RayResult* result) {
-    if (!Refine(dir_W, z_a, z_b, DecodeTsdf(tsdf_a), DecodeTsdf(tsdf_b), voxel_z, result))
+             float voxel_z, RayResult* result, bool newton = true) {
+    if (!Refine(dir_W, z_a, z_b, DecodeTsdf(tsdf_a), DecodeTsdf(tsdf_b), voxel_z, result, newton))
       return false;
     if (result->z < params_.min_depth_m || result->z > params_.max_depth_m) {
       *result = RayResult{};
@@ -1107,8 +1169,253 @@ class RayCaster {
     return true;
   }
 
+#if VOXPLAN_RAYCAST_AVX2
+  // Crossings the packet march found, refined kPacket at a time (RefineCrossings).
+  struct alignas(32) Crossings {
+    float dir_W[3][kPacket], z_a[kPacket], z_b[kPacket], voxel_z[kPacket], z_end[kPacket];
+    int32_t tsdf_a[kPacket], tsdf_b[kPacket];
+    int32_t block_index[3][kPacket];  // the block the march sampled at z_b
+    const TsdfBlock* block[kPacket];
+    size_t pixel[kPacket];
+    int count = 0;
+  };
+  // A ray whose crossing had no zero, to march on from it.
+  struct Resume {
+    Eigen::Vector3f dir_W;
+    float z_b, z_end;
+    int16_t tsdf_b;
+    size_t pixel;
+  };
+
+  // Cross for each of the crossings, as if called one by one: bit j of the result set when
+  // crossing j has its result in results[j], clear when the interpolant has no zero there.
+  // Refine's usual path (two Newton steps on complete cells, then normal and colour) runs in
+  // AVX2 lanes with the scalar code's float operations in its order, so the results are the
+  // same bytes; a lane that leaves that path (an unobserved corner, a grazing slope, a step out
+  // of bounds) is refined by Cross itself.
+  VOXPLAN_TARGET_AVX2 unsigned RefineCrossings(const Crossings& c, RayResult results[kPacket]) {
+    using namespace avx2;
+    const __m256i zero = _mm256_setzero_si256(), minus_one = _mm256_set1_epi32(-1);
+    const __m256 dir[3] = {LoadF(c.dir_W[0]), LoadF(c.dir_W[1]), LoadF(c.dir_W[2])};
+    const __m256 z_a = LoadF(c.z_a), z_b = LoadF(c.z_b), voxel_z = LoadF(c.voxel_z);
+    const __m256 nearest_a = Decode(Load(c.tsdf_a)), nearest_b = Decode(Load(c.tsdf_b));
+    const __m256 max_slope = Set(-kMinSlopeFraction * sampler_.voxel_m() / sampler_.trunc_m());
+    const __m256 dq_dz = Set(sampler_.inv_voxel());
+    const __m256i min_weight_minus_one =
+        _mm256_set1_epi32(int32_t(sampler_.min_weight_fixed()) - 1);
+    // Lanes on the usual path (`ok`) and those done with their Newton steps.
+    __m256i ok =
+        _mm256_cmpgt_epi32(_mm256_set1_epi32(c.count), _mm256_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7));
+    __m256i converged = zero;
+    __m256 z = _mm256_add_ps(z_a, _mm256_div_ps(_mm256_mul_ps(_mm256_sub_ps(z_b, z_a), nearest_a),
+                                                _mm256_sub_ps(nearest_a, nearest_b)));
+    // Per lane, the last sampled cell: its corners (block, voxel), position and gradient.
+    alignas(32) const TsdfBlock* corner_block[8][kPacket];
+    alignas(32) int32_t corner_index[8][kPacket];
+    // The block of each lane's cell, starting from the block the march last sampled.
+    alignas(32) int32_t block_index[3][kPacket];
+    alignas(32) const TsdfBlock* block[kPacket];
+    std::memcpy(block_index, c.block_index, sizeof(block_index));
+    std::memcpy(block, c.block, sizeof(block));
+    for (int j = 0; j < 8; ++j) {  // lanes without a crossing read a valid block
+      std::fill(corner_block[j], corner_block[j] + kPacket, &kNoBlock);
+      std::fill(corner_index[j], corner_index[j] + kPacket, 0);
+    }
+    __m256 frac[3] = {}, gradient[3] = {};
+    for (int k = 0; k < kNewtonIterations; ++k) {
+      const __m256i active = AndNot(converged, ok);
+      const int active_bits = _mm256_movemask_ps(_mm256_castsi256_ps(active));
+      if (!active_bits) break;
+      // Sampler::Gather: the cell's corner 0 and the position in it, in voxel units.
+      alignas(32) int32_t base[3][kPacket];
+      __m256i g[3], changed = zero, inside_block = active;
+      __m256 f_new[3];
+      for (int a = 0; a < 3; ++a) {
+        const __m256 p = _mm256_add_ps(Set(origin_W_[a]), _mm256_mul_ps(z, dir[a]));
+        const __m256 q = _mm256_sub_ps(_mm256_mul_ps(p, Set(sampler_.inv_voxel())), Set(0.5f));
+        g[a] = Floor(q);
+        f_new[a] = _mm256_sub_ps(q, _mm256_cvtepi32_ps(g[a]));
+        Store(base[a], g[a]);
+        const __m256i b = _mm256_srai_epi32(g[a], kBlockShift);
+        changed = _mm256_or_si256(changed,
+                                  AndNot(_mm256_cmpeq_epi32(b, Load(block_index[a])), minus_one));
+        Store(block_index[a], _mm256_blendv_epi8(Load(block_index[a]), b, active));
+        // All eight corners in the block: corner 0 below its last voxel on every axis.
+        inside_block = _mm256_and_si256(
+            inside_block,
+            _mm256_cmpgt_epi32(_mm256_set1_epi32(kBlockMask),
+                               _mm256_and_si256(g[a], _mm256_set1_epi32(kBlockMask))));
+      }
+      changed = _mm256_and_si256(changed, active);
+      for (int bits = _mm256_movemask_ps(_mm256_castsi256_ps(changed)); bits; bits &= bits - 1) {
+        const int l = std::countr_zero(unsigned(bits));
+        const TsdfBlock* found = sampler_.FindUncached(
+            BlockIndex{block_index[0][l], block_index[1][l], block_index[2][l]});
+        block[l] = found ? found : &kNoBlock;
+      }
+      // Corner j of a cell inside one block: its block, at a fixed offset from corner 0.
+      const __m256i i0 = LinearIndex(g);
+      const __m256i active_lo = _mm256_cvtepi32_epi64(_mm256_castsi256_si128(active));
+      const __m256i active_hi = _mm256_cvtepi32_epi64(_mm256_extracti128_si256(active, 1));
+      const __m256i block_lo = Load(block), block_hi = Load(block + 4);
+      for (int j = 0; j < 8; ++j) {
+        Store(
+            corner_index[j],
+            _mm256_blendv_epi8(Load(corner_index[j]),
+                               _mm256_add_epi32(i0, _mm256_set1_epi32(kCornerOffset[j])), active));
+        Store(corner_block[j], _mm256_blendv_epi8(Load(corner_block[j]), block_lo, active_lo));
+        Store(corner_block[j] + 4,
+              _mm256_blendv_epi8(Load(corner_block[j] + 4), block_hi, active_hi));
+      }
+      // Cells across block faces, lane by lane.
+      for (int bits = _mm256_movemask_ps(_mm256_castsi256_ps(AndNot(inside_block, active))); bits;
+           bits &= bits - 1) {
+        const int l = std::countr_zero(unsigned(bits));
+        const TsdfBlock* blocks[8];
+        int index[8];
+        sampler_.CornersAcross(GlobalVoxelIndex{base[0][l], base[1][l], base[2][l]}, blocks, index);
+        for (int j = 0; j < 8; ++j) corner_block[j][l] = blocks[j], corner_index[j][l] = index[j];
+      }
+      // The corners' distances and weights (LoadCorners); a lane with an unobserved corner
+      // leaves the usual path.
+      __m256 t[8];
+      __m256i complete = minus_one;
+      for (int j = 0; j < 8; ++j) {
+        const __m256i offset = _mm256_add_epi32(Load(corner_index[j]), Load(corner_index[j]));
+        const __m256i raw = Gather32(corner_block[j], offset);
+        t[j] = Decode(_mm256_srai_epi32(_mm256_slli_epi32(raw, 16), 16));
+        const __m256i weight = _mm256_and_si256(
+            Gather32(corner_block[j], _mm256_add_epi32(offset, _mm256_set1_epi32(kWeightOffset))),
+            _mm256_set1_epi32(0xffff));
+        complete = _mm256_and_si256(complete, _mm256_cmpgt_epi32(weight, min_weight_minus_one));
+      }
+      ok = AndNot(AndNot(complete, active), ok);
+      // ValueAndGradientSse2, lane by lane: edge j of four per axis, then the four summed in
+      // pairs.
+      const __m256 fx = f_new[0], fy = f_new[1], fz = f_new[2];
+      __m256 value[4], gx[4], gy[4], gz[4];
+      for (int j = 0; j < 4; ++j) {
+        const bool odd = j & 1, high = j >= 2;
+        const __m256 wx = Lerp(odd, fx), wy = Lerp(high, fy), wz = Lerp(high, fz);
+        const __m256 wy_edge = Lerp(odd, fy);
+        const __m256 d_z = _mm256_sub_ps(t[j + 4], t[j]);
+        static constexpr int kX[4][2] = {{1, 0}, {3, 2}, {5, 4}, {7, 6}};
+        static constexpr int kY[4][2] = {{2, 0}, {3, 1}, {6, 4}, {7, 5}};
+        const __m256 d_x = _mm256_sub_ps(t[kX[j][0]], t[kX[j][1]]);
+        const __m256 d_y = _mm256_sub_ps(t[kY[j][0]], t[kY[j][1]]);
+        const __m256 wxy = _mm256_mul_ps(wx, wy);
+        value[j] = _mm256_mul_ps(wxy, _mm256_add_ps(t[j], _mm256_mul_ps(fz, d_z)));
+        gx[j] = _mm256_mul_ps(_mm256_mul_ps(wy_edge, wz), d_x);
+        gy[j] = _mm256_mul_ps(_mm256_mul_ps(wx, wz), d_y);
+        gz[j] = _mm256_mul_ps(wxy, d_z);
+      }
+      const __m256 f = Sum4(value), g_new[3] = {Sum4(gx), Sum4(gy), Sum4(gz)};
+      // Refine's Newton step; Eigen's dot sums x + (y + z).
+      const __m256 slope = _mm256_mul_ps(
+          _mm256_add_ps(
+              _mm256_mul_ps(g_new[0], dir[0]),
+              _mm256_add_ps(_mm256_mul_ps(g_new[1], dir[1]), _mm256_mul_ps(g_new[2], dir[2]))),
+          dq_dz);
+      const __m256 dz = _mm256_div_ps(_mm256_sub_ps(_mm256_setzero_ps(), f), slope);
+      const __m256 z_next = _mm256_add_ps(z, dz);
+      const __m256 steep = _mm256_cmp_ps(_mm256_mul_ps(slope, voxel_z), max_slope, _CMP_LT_OQ);
+      const __m256 inside =
+          _mm256_and_ps(_mm256_cmp_ps(z_next, _mm256_sub_ps(z_a, voxel_z), _CMP_GT_OQ),
+                        _mm256_cmp_ps(z_next, _mm256_add_ps(z_b, voxel_z), _CMP_LT_OQ));
+      ok = AndNot(AndNot(_mm256_castps_si256(_mm256_and_ps(steep, inside)), active), ok);
+      const __m256i stepped = _mm256_and_si256(active, ok);
+      z = Blend(z, z_next, stepped);
+      for (int a = 0; a < 3; ++a) {
+        frac[a] = Blend(frac[a], f_new[a], stepped);
+        gradient[a] = Blend(gradient[a], g_new[a], stepped);
+      }
+      const __m256 abs_dz = _mm256_andnot_ps(Set(-0.f), dz);
+      const __m256i small = _mm256_castps_si256(
+          _mm256_cmp_ps(abs_dz, _mm256_mul_ps(Set(kConvergedVoxels), voxel_z), _CMP_LT_OQ));
+      converged = _mm256_or_si256(
+          converged, k + 1 == kNewtonIterations ? stepped : _mm256_and_si256(stepped, small));
+    }
+    ok = _mm256_and_si256(ok, converged);
+
+    alignas(32) float z_out[kPacket], normal[3][kPacket];
+    alignas(32) uint32_t color[kPacket];
+    _mm256_store_ps(z_out, z);
+    if (params_.with_normals) {
+      const __m256 norm =
+          _mm256_sqrt_ps(_mm256_add_ps(_mm256_mul_ps(gradient[0], gradient[0]),
+                                       _mm256_add_ps(_mm256_mul_ps(gradient[1], gradient[1]),
+                                                     _mm256_mul_ps(gradient[2], gradient[2]))));
+      const __m256 positive = _mm256_cmp_ps(norm, _mm256_setzero_ps(), _CMP_GT_OQ);
+      for (int a = 0; a < 3; ++a)
+        _mm256_store_ps(normal[a],
+                        _mm256_blendv_ps(Set(kNaN), _mm256_div_ps(gradient[a], norm), positive));
+    }
+    if (params_.with_color) {
+      // BlendChannelsSse2, lane by lane: corner-pair j of each channel, the pairs summed in
+      // pairs. A channel byte is the top one of the 32 bits that end at it (inside the block).
+      const __m256 fx = frac[0], fy = frac[1], fz = frac[2];
+      __m256 w_lo[4], w_hi[4];
+      for (int j = 0; j < 4; ++j) {
+        const __m256 wxy = _mm256_mul_ps(Lerp(j & 1, fx), Lerp(j >= 2, fy));
+        w_lo[j] = _mm256_mul_ps(wxy, _mm256_sub_ps(Set(1.f), fz));
+        w_hi[j] = _mm256_mul_ps(wxy, fz);
+      }
+      __m256 w[4];
+      for (int j = 0; j < 4; ++j) w[j] = _mm256_add_ps(w_lo[j], w_hi[j]);
+      const __m256 sum_w = Sum4(w);
+      const __m256 inv = _mm256_div_ps(Set(1.f), sum_w);
+      __m256i rgb = zero;
+      constexpr size_t kChannel[3] = {offsetof(TsdfBlock, r), offsetof(TsdfBlock, g),
+                                      offsetof(TsdfBlock, b)};
+      for (int ch = 0; ch < 3; ++ch) {
+        __m256 corner[8], pair[4];
+        for (int j = 0; j < 8; ++j) {
+          const __m256i offset =
+              _mm256_add_epi32(Load(corner_index[j]), _mm256_set1_epi32(int32_t(kChannel[ch]) - 3));
+          corner[j] = _mm256_cvtepi32_ps(_mm256_srli_epi32(Gather32(corner_block[j], offset), 24));
+        }
+        for (int j = 0; j < 4; ++j)
+          pair[j] = _mm256_add_ps(_mm256_mul_ps(corner[j], w_lo[j]),
+                                  _mm256_mul_ps(corner[j + 4], w_hi[j]));
+        const __m256 scaled = _mm256_add_ps(_mm256_mul_ps(Sum4(pair), inv), Set(0.5f));
+        const __m256i c8 = _mm256_cvttps_epi32(
+            _mm256_min_ps(_mm256_max_ps(scaled, _mm256_setzero_ps()), Set(255.f)));
+        rgb = _mm256_or_si256(rgb, _mm256_slli_epi32(c8, 8 * ch));
+      }
+      const __m256i positive =
+          _mm256_castps_si256(_mm256_cmp_ps(sum_w, _mm256_setzero_ps(), _CMP_GT_OQ));
+      Store(color, _mm256_and_si256(rgb, positive));
+    }
+
+    const int ok_bits = _mm256_movemask_ps(_mm256_castsi256_ps(ok));
+    unsigned found = 0;
+    for (int j = 0; j < c.count; ++j) {
+      const Eigen::Vector3f dir_W(c.dir_W[0][j], c.dir_W[1][j], c.dir_W[2][j]);
+      RayResult& result = results[j];
+      result = RayResult{};
+      result.status = RayStatus::kFree;  // the march met observed voxels
+      if (!((ok_bits >> j) & 1)) {
+        found |= unsigned(Cross(dir_W, c.z_a[j], c.z_b[j], int16_t(c.tsdf_a[j]),
+                                int16_t(c.tsdf_b[j]), c.voxel_z[j], &result, /*newton=*/false))
+                 << j;
+        continue;
+      }
+      found |= 1u << j;
+      if (z_out[j] < params_.min_depth_m || z_out[j] > params_.max_depth_m) continue;  // kFree
+      result.status = RayStatus::kHit;
+      result.z = z_out[j];
+      if (params_.with_normals) result.normal_W = {normal[0][j], normal[1][j], normal[2][j]};
+      if (params_.with_color) result.color = color[j];
+    }
+    return found;
+  }
+#endif
+
   Sampler sampler_;
   RaycastParams params_;
+#if VOXPLAN_RAYCAST_AVX2
+  std::vector<Resume> resumes_;
+#endif
   Eigen::Vector3f origin_W_, d0_W_, du_W_, dv_W_, origin_vox_;
 #if VOXPLAN_RAYCAST_SSE2
   __m128 origin_vox_lanes_;
