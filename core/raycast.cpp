@@ -1209,33 +1209,36 @@ class RayCaster {
     __m256i converged = zero;
     __m256 z = _mm256_add_ps(z_a, _mm256_div_ps(_mm256_mul_ps(_mm256_sub_ps(z_b, z_a), nearest_a),
                                                 _mm256_sub_ps(nearest_a, nearest_b)));
-    // Per lane, the last sampled cell: its corners (block, voxel), position and gradient.
-    alignas(32) const TsdfBlock* corner_block[8][kPacket];
-    alignas(32) int32_t corner_index[8][kPacket];
-    // The block of each lane's cell, starting from the block the march last sampled.
-    alignas(32) int32_t block_index[3][kPacket];
+    // Per lane, the last sampled cell: corner 0, its block (first the block the march last
+    // sampled), the corners of a cell across block faces, the position and gradient, and the
+    // corners' distances and weights as x-pairs (corner 2p in the low 16 bits of pair p, corner
+    // 2p + 1 in the high ones), loaded lane by lane into rows that AVX2 then reads.
+    alignas(32) int32_t cell_base[3][kPacket], cell_i0[kPacket], block_index[3][kPacket];
     alignas(32) const TsdfBlock* block[kPacket];
+    const TsdfBlock* across_block[kPacket][8];
+    int across_index[kPacket][8];
+    alignas(32) uint32_t tsdf_pairs[4][kPacket] = {}, weight_pairs[4][kPacket] = {};
+    unsigned one_block = 0;  // bit l: lane l's cell lies in block[l]
     std::memcpy(block_index, c.block_index, sizeof(block_index));
     std::memcpy(block, c.block, sizeof(block));
-    for (int j = 0; j < 8; ++j) {  // lanes without a crossing read a valid block
-      std::fill(corner_block[j], corner_block[j] + kPacket, &kNoBlock);
-      std::fill(corner_index[j], corner_index[j] + kPacket, 0);
-    }
+    std::fill(&cell_base[0][0], &cell_base[0][0] + 3 * kPacket,
+              std::numeric_limits<int32_t>::min());
     __m256 frac[3] = {}, gradient[3] = {};
     for (int k = 0; k < kNewtonIterations; ++k) {
       const __m256i active = AndNot(converged, ok);
       const int active_bits = _mm256_movemask_ps(_mm256_castsi256_ps(active));
       if (!active_bits) break;
       // Sampler::Gather: the cell's corner 0 and the position in it, in voxel units.
-      alignas(32) int32_t base[3][kPacket];
-      __m256i g[3], changed = zero, inside_block = active;
+      __m256i g[3], changed = zero, moved = zero, inside_block = minus_one;
       __m256 f_new[3];
       for (int a = 0; a < 3; ++a) {
         const __m256 p = _mm256_add_ps(Set(origin_W_[a]), _mm256_mul_ps(z, dir[a]));
         const __m256 q = _mm256_sub_ps(_mm256_mul_ps(p, Set(sampler_.inv_voxel())), Set(0.5f));
         g[a] = Floor(q);
         f_new[a] = _mm256_sub_ps(q, _mm256_cvtepi32_ps(g[a]));
-        Store(base[a], g[a]);
+        moved =
+            _mm256_or_si256(moved, AndNot(_mm256_cmpeq_epi32(g[a], Load(cell_base[a])), minus_one));
+        Store(cell_base[a], _mm256_blendv_epi8(Load(cell_base[a]), g[a], active));
         const __m256i b = _mm256_srai_epi32(g[a], kBlockShift);
         changed = _mm256_or_si256(changed,
                                   AndNot(_mm256_cmpeq_epi32(b, Load(block_index[a])), minus_one));
@@ -1246,6 +1249,7 @@ class RayCaster {
             _mm256_cmpgt_epi32(_mm256_set1_epi32(kBlockMask),
                                _mm256_and_si256(g[a], _mm256_set1_epi32(kBlockMask))));
       }
+      Store(cell_i0, _mm256_blendv_epi8(Load(cell_i0), LinearIndex(g), active));
       changed = _mm256_and_si256(changed, active);
       for (int bits = _mm256_movemask_ps(_mm256_castsi256_ps(changed)); bits; bits &= bits - 1) {
         const int l = std::countr_zero(unsigned(bits));
@@ -1253,41 +1257,46 @@ class RayCaster {
             BlockIndex{block_index[0][l], block_index[1][l], block_index[2][l]});
         block[l] = found ? found : &kNoBlock;
       }
-      // Corner j of a cell inside one block: its block, at a fixed offset from corner 0.
-      const __m256i i0 = LinearIndex(g);
-      const __m256i active_lo = _mm256_cvtepi32_epi64(_mm256_castsi256_si128(active));
-      const __m256i active_hi = _mm256_cvtepi32_epi64(_mm256_extracti128_si256(active, 1));
-      const __m256i block_lo = Load(block), block_hi = Load(block + 4);
-      for (int j = 0; j < 8; ++j) {
-        Store(
-            corner_index[j],
-            _mm256_blendv_epi8(Load(corner_index[j]),
-                               _mm256_add_epi32(i0, _mm256_set1_epi32(kCornerOffset[j])), active));
-        Store(corner_block[j], _mm256_blendv_epi8(Load(corner_block[j]), block_lo, active_lo));
-        Store(corner_block[j] + 4,
-              _mm256_blendv_epi8(Load(corner_block[j] + 4), block_hi, active_hi));
-      }
-      // Cells across block faces, lane by lane.
-      for (int bits = _mm256_movemask_ps(_mm256_castsi256_ps(AndNot(inside_block, active))); bits;
-           bits &= bits - 1) {
+      // The corners of the lanes whose cell moved (LoadCorners, LoadCornersAcross).
+      const int inside_bits = _mm256_movemask_ps(_mm256_castsi256_ps(inside_block));
+      for (int bits = _mm256_movemask_ps(_mm256_castsi256_ps(_mm256_and_si256(moved, active)));
+           bits; bits &= bits - 1) {
         const int l = std::countr_zero(unsigned(bits));
-        const TsdfBlock* blocks[8];
-        int index[8];
-        sampler_.CornersAcross(GlobalVoxelIndex{base[0][l], base[1][l], base[2][l]}, blocks, index);
-        for (int j = 0; j < 8; ++j) corner_block[j][l] = blocks[j], corner_index[j][l] = index[j];
+        if ((inside_bits >> l) & 1) {
+          one_block |= 1u << l;
+          const int16_t* tsdf = block[l]->tsdf + cell_i0[l];
+          const uint16_t* weight = block[l]->weight + cell_i0[l];
+          for (int p = 0; p < 4; ++p) {
+            std::memcpy(&tsdf_pairs[p][l], tsdf + kCornerOffset[2 * p], sizeof(uint32_t));
+            std::memcpy(&weight_pairs[p][l], weight + kCornerOffset[2 * p], sizeof(uint32_t));
+          }
+          continue;
+        }
+        one_block &= ~(1u << l);
+        const TsdfBlock** blocks = across_block[l];
+        const int* index = across_index[l];
+        sampler_.CornersAcross(GlobalVoxelIndex{cell_base[0][l], cell_base[1][l], cell_base[2][l]},
+                               blocks, across_index[l]);
+        for (int p = 0; p < 4; ++p) {
+          const int lo = 2 * p, hi = 2 * p + 1;
+          tsdf_pairs[p][l] = uint32_t(uint16_t(blocks[lo]->tsdf[index[lo]])) |
+                             uint32_t(uint16_t(blocks[hi]->tsdf[index[hi]])) << 16;
+          weight_pairs[p][l] = uint32_t(blocks[lo]->weight[index[lo]]) |
+                               uint32_t(blocks[hi]->weight[index[hi]]) << 16;
+        }
       }
-      // The corners' distances and weights (LoadCorners); a lane with an unobserved corner
-      // leaves the usual path.
+      // Decoded as LoadCorners does; a lane with an unobserved corner leaves the usual path.
       __m256 t[8];
       __m256i complete = minus_one;
-      for (int j = 0; j < 8; ++j) {
-        const __m256i offset = _mm256_add_epi32(Load(corner_index[j]), Load(corner_index[j]));
-        const __m256i raw = Gather32(corner_block[j], offset);
-        t[j] = Decode(_mm256_srai_epi32(_mm256_slli_epi32(raw, 16), 16));
-        const __m256i weight = _mm256_and_si256(
-            Gather32(corner_block[j], _mm256_add_epi32(offset, _mm256_set1_epi32(kWeightOffset))),
-            _mm256_set1_epi32(0xffff));
-        complete = _mm256_and_si256(complete, _mm256_cmpgt_epi32(weight, min_weight_minus_one));
+      const __m256i low16 = _mm256_set1_epi32(0xffff);
+      for (int p = 0; p < 4; ++p) {
+        const __m256i tsdf = Load(tsdf_pairs[p]), weight = Load(weight_pairs[p]);
+        t[2 * p] = Decode(_mm256_srai_epi32(_mm256_slli_epi32(tsdf, 16), 16));
+        t[2 * p + 1] = Decode(_mm256_srai_epi32(tsdf, 16));
+        complete = _mm256_and_si256(
+            complete, _mm256_and_si256(
+                          _mm256_cmpgt_epi32(_mm256_and_si256(weight, low16), min_weight_minus_one),
+                          _mm256_cmpgt_epi32(_mm256_srli_epi32(weight, 16), min_weight_minus_one)));
       }
       ok = AndNot(AndNot(complete, active), ok);
       // ValueAndGradientSse2, lane by lane: edge j of four per axis, then the four summed in
@@ -1352,7 +1361,7 @@ class RayCaster {
     }
     if (params_.with_color) {
       // BlendChannelsSse2, lane by lane: corner-pair j of each channel, the pairs summed in
-      // pairs. A channel byte is the top one of the 32 bits that end at it (inside the block).
+      // pairs.
       const __m256 fx = frac[0], fy = frac[1], fz = frac[2];
       __m256 w_lo[4], w_hi[4];
       for (int j = 0; j < 4; ++j) {
@@ -1364,15 +1373,36 @@ class RayCaster {
       for (int j = 0; j < 4; ++j) w[j] = _mm256_add_ps(w_lo[j], w_hi[j]);
       const __m256 sum_w = Sum4(w);
       const __m256 inv = _mm256_div_ps(Set(1.f), sum_w);
+      // The corners' colours as x-pairs (corner 2p in the low byte of pair p, 2p + 1 next).
+      alignas(32) uint32_t color_pairs[3][4][kPacket] = {};
+      for (int bits = _mm256_movemask_ps(_mm256_castsi256_ps(ok)); bits; bits &= bits - 1) {
+        const int l = std::countr_zero(unsigned(bits));
+        const uint8_t* channel[3] = {block[l]->r, block[l]->g, block[l]->b};
+        for (int ch = 0; ch < 3; ++ch)
+          for (int p = 0; p < 4; ++p) {
+            const int lo = 2 * p, hi = 2 * p + 1;
+            if ((one_block >> l) & 1) {
+              uint16_t pair;
+              std::memcpy(&pair, channel[ch] + cell_i0[l] + kCornerOffset[lo], sizeof(pair));
+              color_pairs[ch][p][l] = pair;
+            } else {
+              const TsdfBlock* const* blocks = across_block[l];
+              const int* index = across_index[l];
+              auto byte = [&](int j) {
+                const TsdfBlock& b = *blocks[j];
+                return uint32_t((ch == 0 ? b.r : ch == 1 ? b.g : b.b)[index[j]]);
+              };
+              color_pairs[ch][p][l] = byte(lo) | byte(hi) << 8;
+            }
+          }
+      }
       __m256i rgb = zero;
-      constexpr size_t kChannel[3] = {offsetof(TsdfBlock, r), offsetof(TsdfBlock, g),
-                                      offsetof(TsdfBlock, b)};
       for (int ch = 0; ch < 3; ++ch) {
         __m256 corner[8], pair[4];
-        for (int j = 0; j < 8; ++j) {
-          const __m256i offset =
-              _mm256_add_epi32(Load(corner_index[j]), _mm256_set1_epi32(int32_t(kChannel[ch]) - 3));
-          corner[j] = _mm256_cvtepi32_ps(_mm256_srli_epi32(Gather32(corner_block[j], offset), 24));
+        for (int p = 0; p < 4; ++p) {
+          const __m256i pairs = Load(color_pairs[ch][p]);
+          corner[2 * p] = _mm256_cvtepi32_ps(_mm256_and_si256(pairs, _mm256_set1_epi32(0xff)));
+          corner[2 * p + 1] = _mm256_cvtepi32_ps(_mm256_srli_epi32(pairs, 8));
         }
         for (int j = 0; j < 4; ++j)
           pair[j] = _mm256_add_ps(_mm256_mul_ps(corner[j], w_lo[j]),
