@@ -335,7 +335,6 @@ using raycast_detail::kCornerOffset;
 
 // Read where a ray has no block: never observed.
 const TsdfBlock kNoBlock{};
-constexpr int32_t kWeightOffset = int32_t(offsetof(TsdfBlock, weight));
 
 // The 2x2x2 voxel centres around a point, for trilinear interpolation of TSDF, colour and the
 // gradient. Corner k is offset (k & 1, (k >> 1) & 1, k >> 2).
@@ -642,17 +641,6 @@ VOXPLAN_TARGET_AVX2 inline __m256i LinearIndex(const __m256i g[3]) {
       _mm256_and_si256(g[0], mask),
       _mm256_add_epi32(_mm256_slli_epi32(_mm256_and_si256(g[1], mask), kBlockShift),
                        _mm256_slli_epi32(_mm256_and_si256(g[2], mask), 2 * kBlockShift)));
-}
-// The 32 bits at byte offset[l] of *block[l], for 8 lanes.
-VOXPLAN_TARGET_AVX2 inline __m256i Gather32(const TsdfBlock* const block[8], __m256i offset) {
-  const __m128i lo = _mm256_i64gather_epi32(
-      nullptr, _mm256_add_epi64(Load(block), _mm256_cvtepi32_epi64(_mm256_castsi256_si128(offset))),
-      1);
-  const __m128i hi = _mm256_i64gather_epi32(
-      nullptr,
-      _mm256_add_epi64(Load(block + 4), _mm256_cvtepi32_epi64(_mm256_extracti128_si256(offset, 1))),
-      1);
-  return _mm256_set_m128i(hi, lo);
 }
 }  // namespace avx2
 #endif
@@ -965,15 +953,16 @@ class RayCaster {
           lanes.has_block[l] = block ? -1 : 0;
           lanes.block[l] = block ? block : &kNoBlock;
         }
-        // tsdf[i] and weight[i] of each lane's block (two bytes more are read, inside the block).
-        const __m256i i = avx2::LinearIndex(g);
-        const __m256i offset_tsdf = _mm256_add_epi32(i, i);
-        const __m256i tsdf = _mm256_srai_epi32(
-            _mm256_slli_epi32(avx2::Gather32(lanes.block + base, offset_tsdf), 16), 16);
-        const __m256i weight = _mm256_and_si256(
-            avx2::Gather32(lanes.block + base,
-                           _mm256_add_epi32(offset_tsdf, _mm256_set1_epi32(kWeightOffset))),
-            _mm256_set1_epi32(0xffff));
+        // tsdf[i] and weight[i] of each lane's block, loaded lane by lane (faster here than two
+        // AVX2 gathers).
+        alignas(32) int32_t index[kPacket], lane_tsdf[kPacket], lane_weight[kPacket];
+        avx2::Store(index, avx2::LinearIndex(g));
+        for (int l = 0; l < kPacket; ++l) {
+          const TsdfBlock& block = *lanes.block[base + l];
+          lane_tsdf[l] = block.tsdf[index[l]];
+          lane_weight[l] = block.weight[index[l]];
+        }
+        const __m256i tsdf = avx2::Load(lane_tsdf), weight = avx2::Load(lane_weight);
 
         const __m256i has_block = avx2::Load(lanes.has_block + base);
         const __m256i no_block = avx2::AndNot(has_block, in_range);
