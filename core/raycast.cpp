@@ -1206,7 +1206,8 @@ class RayCaster {
     alignas(32) const TsdfBlock* block[kPacket];
     const TsdfBlock* across_block[kPacket][8];
     int across_index[kPacket][8];
-    alignas(32) uint32_t tsdf_pairs[4][kPacket] = {}, weight_pairs[4][kPacket] = {};
+    auto& tsdf_pairs = rows_.tsdf_pairs;
+    auto& weight_pairs = rows_.weight_pairs;
     unsigned one_block = 0;  // bit l: lane l's cell lies in block[l]
     std::memcpy(block_index, c.block_index, sizeof(block_index));
     std::memcpy(block, c.block, sizeof(block));
@@ -1218,7 +1219,8 @@ class RayCaster {
       const int active_bits = _mm256_movemask_ps(_mm256_castsi256_ps(active));
       if (!active_bits) break;
       // Sampler::Gather: the cell's corner 0 and the position in it, in voxel units.
-      __m256i g[3], changed = zero, moved = zero, inside_block = minus_one;
+      // A lane's first cell is always loaded; the rows hold an earlier batch's values.
+      __m256i g[3], changed = zero, moved = k == 0 ? minus_one : zero, inside_block = minus_one;
       __m256 f_new[3];
       for (int a = 0; a < 3; ++a) {
         const __m256 p = _mm256_add_ps(Set(origin_W_[a]), _mm256_mul_ps(z, dir[a]));
@@ -1363,27 +1365,26 @@ class RayCaster {
       const __m256 sum_w = Sum4(w);
       const __m256 inv = _mm256_div_ps(Set(1.f), sum_w);
       // The corners' colours as x-pairs (corner 2p in the low byte of pair p, 2p + 1 next).
-      alignas(32) uint32_t color_pairs[3][4][kPacket] = {};
+      auto& color_pairs = rows_.color_pairs;
       for (int bits = _mm256_movemask_ps(_mm256_castsi256_ps(ok)); bits; bits &= bits - 1) {
         const int l = std::countr_zero(unsigned(bits));
-        const uint8_t* channel[3] = {block[l]->r, block[l]->g, block[l]->b};
-        for (int ch = 0; ch < 3; ++ch)
-          for (int p = 0; p < 4; ++p) {
-            const int lo = 2 * p, hi = 2 * p + 1;
-            if ((one_block >> l) & 1) {
+        if ((one_block >> l) & 1) {
+          const uint8_t* channel[3] = {block[l]->r, block[l]->g, block[l]->b};
+          for (int ch = 0; ch < 3; ++ch)
+            for (int p = 0; p < 4; ++p) {
               uint16_t pair;
-              std::memcpy(&pair, channel[ch] + cell_i0[l] + kCornerOffset[lo], sizeof(pair));
+              std::memcpy(&pair, channel[ch] + cell_i0[l] + kCornerOffset[2 * p], sizeof(pair));
               color_pairs[ch][p][l] = pair;
-            } else {
-              const TsdfBlock* const* blocks = across_block[l];
-              const int* index = across_index[l];
-              auto byte = [&](int j) {
-                const TsdfBlock& b = *blocks[j];
-                return uint32_t((ch == 0 ? b.r : ch == 1 ? b.g : b.b)[index[j]]);
-              };
-              color_pairs[ch][p][l] = byte(lo) | byte(hi) << 8;
             }
-          }
+          continue;
+        }
+        for (int p = 0; p < 4; ++p) {
+          const TsdfBlock &lo = *across_block[l][2 * p], &hi = *across_block[l][2 * p + 1];
+          const int i_lo = across_index[l][2 * p], i_hi = across_index[l][2 * p + 1];
+          color_pairs[0][p][l] = uint32_t(lo.r[i_lo]) | uint32_t(hi.r[i_hi]) << 8;
+          color_pairs[1][p][l] = uint32_t(lo.g[i_lo]) | uint32_t(hi.g[i_hi]) << 8;
+          color_pairs[2][p][l] = uint32_t(lo.b[i_lo]) | uint32_t(hi.b[i_hi]) << 8;
+        }
       }
       __m256i rgb = zero;
       for (int ch = 0; ch < 3; ++ch) {
@@ -1434,6 +1435,12 @@ class RayCaster {
   RaycastParams params_;
 #if VOXPLAN_RAYCAST_AVX2
   std::vector<Resume> resumes_;
+  // RefineCrossings' rows of corner values, kept between batches (filling them takes longer
+  // than a batch's refinement): a lane reads only what its own crossing loaded.
+  struct alignas(32) Rows {
+    uint32_t tsdf_pairs[4][kPacket] = {}, weight_pairs[4][kPacket] = {};
+    uint32_t color_pairs[3][4][kPacket] = {};
+  } rows_;
 #endif
   Eigen::Vector3f origin_W_, d0_W_, du_W_, dv_W_, origin_vox_;
 #if VOXPLAN_RAYCAST_SSE2
