@@ -818,7 +818,7 @@ class RayCaster {
   // with -ffp-contract=off), so the images are identical to MarchInterleaved's. The steps have
   // no per-ray branch; block lookups and new rays are handled lane by lane. A lane that meets a
   // crossing hands it on and takes the next ray: crossings are refined kPacket at a time
-  // (RefineCrossings). A worker marches kPackets packets in turn, so that one packet's gathers
+  // (RefineCrossings). A worker marches kPackets packets in turn, so that one packet's loads
   // and lookups overlap another's.
   template <class Write>
   VOXPLAN_TARGET_AVX2 void MarchPackets(const RayTask* tasks, size_t num_tasks, Write&& write) {
@@ -921,9 +921,9 @@ class RayCaster {
         _mm256_set1_epi32(int32_t(sampler_.min_weight_fixed()) - 1);
     const __m256i stop_at_back_faces = params_.stop_at_back_faces ? minus_one : zero;
 
-    while (num_live > 0 || crossings.count > 0) {
+    while (num_live > 0 || crossings.count > 0 || !resumes.empty()) {
       if (num_live == 0) {  // the last crossings, then the rays they resume
-        refine();
+        if (crossings.count > 0) refine();
         for (int l = 0; l < kPacketLanes; ++l) num_live += start_next(l);
         continue;
       }
