@@ -1054,6 +1054,10 @@ class RayCaster {
 #endif
 
  private:
+  // The least steep slope of the normalised TSDF per voxel along a ray that Newton steps follow
+  // (Refine and RefineCrossings alike).
+  float MaxSlope() const { return -kMinSlopeFraction * sampler_.voxel_m() / sampler_.trunc_m(); }
+
   bool Sample(const Eigen::Vector3f& dir_W, float z, Cell* cell, float* tsdf,
               Eigen::Vector3f* gradient) {
     const bool complete = sampler_.Gather(origin_W_ + z * dir_W, cell);
@@ -1073,7 +1077,7 @@ class RayCaster {
     const float z_guess = z_a + (z_b - z_a) * nearest_a / (nearest_a - nearest_b);
     // The slope of the normalised TSDF along the ray must be clearly negative: a head-on ray
     // sees -voxel/trunc per voxel, a grazing one almost nothing.
-    const float max_slope = -kMinSlopeFraction * sampler_.voxel_m() / sampler_.trunc_m();
+    const float max_slope = MaxSlope();
     const float dq_dz = sampler_.inv_voxel();  // voxel-grid units per metre of z
     float z = z_guess;
     Eigen::Vector3f gradient;
@@ -1188,7 +1192,7 @@ class RayCaster {
     const __m256 dir[3] = {LoadF(c.dir_W[0]), LoadF(c.dir_W[1]), LoadF(c.dir_W[2])};
     const __m256 z_a = LoadF(c.z_a), z_b = LoadF(c.z_b), voxel_z = LoadF(c.voxel_z);
     const __m256 nearest_a = Decode(Load(c.tsdf_a)), nearest_b = Decode(Load(c.tsdf_b));
-    const __m256 max_slope = Set(-kMinSlopeFraction * sampler_.voxel_m() / sampler_.trunc_m());
+    const __m256 max_slope = Set(MaxSlope());
     const __m256 dq_dz = Set(sampler_.inv_voxel());
     const __m256i min_weight_minus_one =
         _mm256_set1_epi32(int32_t(sampler_.min_weight_fixed()) - 1);
