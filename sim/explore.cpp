@@ -7,6 +7,7 @@
 #include <limits>
 #include <numbers>
 #include <sstream>
+#include <utility>
 
 #include "core/queries.h"
 #include "fusion/integrate_planning.h"
@@ -103,6 +104,7 @@ class Explorer {
   void Record(bool with_completeness);
   double DistanceTotal() const;
   float CameraYawTarget(const RobotRun& r) const;
+  float CameraPitchTarget(const RobotRun& r) const;
 
   const World& world_;
   const FloorPlan& plan_;
@@ -292,24 +294,35 @@ bool Explorer::RouteTo(RobotRun& r, const QueuedTask& q) {
   return false;
 }
 
+// The plugin's camera trajectory t seconds after it was given: world yaw (turning the short way)
+// and pitch, linear between samples, held before the first and after the last.
+std::pair<float, float> TrajectoryYawPitch(const std::vector<CameraSample>& tr, float t) {
+  if (t <= tr.front().t_s) return {tr.front().yaw_rad, tr.front().pitch_rad};
+  for (size_t i = 1; i < tr.size(); ++i) {
+    if (t > tr[i].t_s) continue;
+    const float span = tr[i].t_s - tr[i - 1].t_s;
+    const float a = span > 0.f ? (t - tr[i - 1].t_s) / span : 1.f;
+    return {tr[i - 1].yaw_rad + a * WrapAngle(tr[i].yaw_rad - tr[i - 1].yaw_rad),
+            tr[i - 1].pitch_rad + a * (tr[i].pitch_rad - tr[i - 1].pitch_rad)};
+  }
+  return {tr.back().yaw_rad, tr.back().pitch_rad};
+}
+
 float Explorer::CameraYawTarget(const RobotRun& r) const {
   // Along the motion unless the plugin said where to look.
-  const std::vector<CameraSample>& tr = r.camera_trajectory;
-  if (tr.empty()) return 0.f;
-  const float t = float(r.t_s - r.trajectory_t0_s);
-  float world_yaw = tr.back().yaw_rad;
-  if (t <= tr.front().t_s) {
-    world_yaw = tr.front().yaw_rad;
-  } else {
-    for (size_t i = 1; i < tr.size(); ++i) {
-      if (t > tr[i].t_s) continue;
-      const float span = tr[i].t_s - tr[i - 1].t_s;
-      const float a = span > 0.f ? (t - tr[i - 1].t_s) / span : 1.f;
-      world_yaw = tr[i - 1].yaw_rad + a * WrapAngle(tr[i].yaw_rad - tr[i - 1].yaw_rad);
-      break;
-    }
-  }
+  if (r.camera_trajectory.empty()) return 0.f;
+  const float world_yaw =
+      TrajectoryYawPitch(r.camera_trajectory, float(r.t_s - r.trajectory_t0_s)).first;
   return WrapAngle(world_yaw - r.robot.state().heading_rad);
+}
+
+float Explorer::CameraPitchTarget(const RobotRun& r) const {
+  // Level unless the plugin said otherwise (a view may have tilted it), within the limits.
+  if (r.camera_trajectory.empty()) return 0.f;
+  const float pitch =
+      TrajectoryYawPitch(r.camera_trajectory, float(r.t_s - r.trajectory_t0_s)).second;
+  const float max_pitch = Deg2Rad(r.robot.params().max_abs_pitch_deg);
+  return std::clamp(pitch, -max_pitch, max_pitch);
 }
 
 // One primitive at the view: turn the base, then the camera, then pitch, then dwell and capture.
@@ -395,8 +408,9 @@ Status Explorer::Advance(RobotRun& r, double t_end_s) {
       VOXPLAN_RETURN_IF_ERROR(AfterPrimitive(r, c));
       continue;
     }
-    if (std::abs(s.camera_pitch_rad) > 1e-3f && r.camera_trajectory.empty()) {
-      VOXPLAN_RETURN_IF_ERROR(r.robot.SetCameraPitch(0.f));
+    const float pitch = CameraPitchTarget(r);
+    if (std::abs(pitch - s.camera_pitch_rad) > 1e-3f) {
+      VOXPLAN_RETURN_IF_ERROR(r.robot.SetCameraPitch(pitch));
       VOXPLAN_RETURN_IF_ERROR(AfterPrimitive(r, c));
       continue;
     }

@@ -111,7 +111,8 @@ void EmitViews(const vp::WorldView& world, vp::PlanOutput& out, const BaselineWo
   const std::vector<vp_path_point> path = PathWithHeadings(points, robot.theta_rad);
   std::vector<vp_task> tasks;
   for (const auto& [k, i] : arrivals) {
-    tasks.push_back(TaskFromView(b.views[size_t(k)], path[i].theta_rad, robot, dwell_s));
+    tasks.push_back(
+        TaskFromView(b.views[size_t(k)], path[i].theta_rad, robot, b.input.vfov_rad, dwell_s));
     out.AddTask(r, tasks.back());
   }
   std::vector<int> taken;

@@ -177,6 +177,10 @@ WorldInput ReadWorld(const vp::WorldView& world, const CommonOptions& options) {
           mode.horizontal_fov_rad < float(2.0 * omt::kPi)) {
         keep_smallest(&in.fov_rad, mode.horizontal_fov_rad);
       }
+      if (std::isfinite(mode.vertical_fov_rad) && mode.vertical_fov_rad > 0.f &&
+          mode.vertical_fov_rad < float(omt::kPi)) {
+        keep_smallest(&in.vfov_rad, mode.vertical_fov_rad);
+      }
       if (std::isfinite(mode.max_range_m) && mode.max_range_m > 0.f) {
         keep_smallest(&in.range_m, mode.max_range_m);
       }
@@ -256,6 +260,14 @@ void SettledCells::Update(const vp::WorldView& world, const WorldInput& input,
     }
     const Eigen::Vector2d p = input.states[r].position_m;
     const int start = g.IndexOf(p);
+    // Unknown floor was looked at only where the camera, at its pitch, saw the whole cell and
+    // the low end of its column: those voxels are seen on rays that meet the floor up to a
+    // tenth further on (0.1 m up, 1.2 m down), so the far end keeps a tenth to spare.
+    constexpr double kColumnSeenFraction = 0.9;
+    const FloorBand floor = VisibleFloor(input.robots[r].camera_height_m, input.vfov_rad,
+                                         input.robots[r].camera_pitch_rad, sensor.d_max_m);
+    const double floor_from_m = floor.near_m + 0.5 * g.resolution_m;
+    const double floor_to_m = kColumnSeenFraction * floor.far_m - 0.5 * g.resolution_m;
     for (int k = 0; k <= rays; ++k) {
       const double yaw = input.states[r].yaw_rad - 0.5 * sensor.fov_rad + sensor.fov_rad * k / rays;
       const Eigen::Vector2d dir(std::cos(yaw), std::sin(yaw));
@@ -272,7 +284,7 @@ void SettledCells::Update(const vp::WorldView& world, const WorldInput& input,
             cells_.insert(key(cell));
           return false;
         }
-        if (in_range) cells_.insert(key(cell));
+        if (in_range && d >= floor_from_m && d <= floor_to_m) cells_.insert(key(cell));
         return true;
       });
     }
@@ -403,14 +415,34 @@ std::vector<vp_path_point> PathWithHeadings(const std::vector<Eigen::Vector2d>& 
   return path;
 }
 
+FloorBand VisibleFloor(double camera_height_m, double vfov_rad, double pitch_rad, double range_m) {
+  FloorBand band{0.0, range_m};
+  if (!(vfov_rad > 0.0) || !(camera_height_m > 0.0)) return band;
+  // The field's lower and upper edges, as angles below the horizon.
+  const double lower_rad = 0.5 * vfov_rad - pitch_rad, upper_rad = -0.5 * vfov_rad - pitch_rad;
+  if (lower_rad <= 0.0) return {std::numeric_limits<double>::infinity(), 0.0};  // no floor
+  if (lower_rad < 0.5 * omt::kPi) band.near_m = camera_height_m / std::tan(lower_rad);
+  if (upper_rad > 0.0) band.far_m = std::min(range_m, camera_height_m / std::tan(upper_rad));
+  return band;
+}
+
+float ViewPitch(const omt::TaskView& view, const vp_robot& robot, double vfov_rad) {
+  double pitch = 0.0;
+  if (view.target_unknown && vfov_rad > 0.0 && robot.camera_height_m > 0.f) {
+    const double below_rad = std::atan2(double(robot.camera_height_m), view.target_near_m);
+    pitch = std::min(0.0, 0.5 * vfov_rad - below_rad);
+  }
+  return std::clamp(float(pitch), robot.min_pitch_rad, robot.max_pitch_rad);
+}
+
 vp_task TaskFromView(const omt::TaskView& view, double theta_rad, const vp_robot& robot,
-                     double dwell_s) {
+                     double vfov_rad, double dwell_s) {
   vp_task t{};
   t.x_m = float(view.position_m.x());
   t.y_m = float(view.position_m.y());
   t.theta_rad = float(omt::WrapAngle(theta_rad));
   t.camera_yaw_rad = float(omt::WrapAngle(view.yaw_rad - theta_rad));
-  t.camera_pitch_rad = std::clamp(0.f, robot.min_pitch_rad, robot.max_pitch_rad);
+  t.camera_pitch_rad = ViewPitch(view, robot, vfov_rad);
   t.dwell_s = float(dwell_s);
   t.mode = robot.mode >= 0 && uint32_t(robot.mode) < robot.mode_count ? robot.mode : 0;
   t.tag = uint32_t(std::max(view.target_cell, 0));

@@ -70,6 +70,7 @@ struct WorldInput {
   float min_clearance_m = 0.f;     // for host geodesic queries: robot_radius_m + margin
   double surface_voxels_ms = 0.0;  // spent in the host's surface voxel query
   double fov_rad = 0.0;            // narrowest horizontal FOV of the robots' modes; 0: unknown
+  double vfov_rad = 0.0;           // narrowest vertical FOV of the robots' modes; 0: unknown
   double range_m = 0.0;            // shortest depth range of the robots' modes; 0: unknown
   // ReadHostReach: per robot the host's geodesic field (min_clearance_m; host memory, valid
   // during the plan call), the cells any of them reaches, and how many robots reach any cell (a
@@ -95,7 +96,8 @@ void ReadHostReach(const vp::WorldView& world, WorldInput* input);
 class SettledCells {
  public:
   // Adds the unresolved cells of every idle robot's camera fan (between the sensor's near and
-  // far range, up to the first surface on each ray). Only a robot that took its view counts: one
+  // far range, up to the first surface on each ray; unknown floor only where the camera, at its
+  // pitch, saw the floor: VisibleFloor). Only a robot that took its view counts: one
   // standing at the last task it was sent to (or never sent anywhere, or told to stop). A robot
   // whose task failed adds nothing until it has reached a task sent after the failure: it
   // stopped where a drive was refused, often facing the very space it could not get to.
@@ -145,11 +147,26 @@ omt::GeodesicProvider HostGeodesics(const vp::WorldView& world, float min_cleara
 std::vector<vp_path_point> PathWithHeadings(const std::vector<Eigen::Vector2d>& points_m,
                                             double start_theta_rad);
 
+// The floor a camera camera_height_m up, pitched by pitch_rad (positive up), sees within its
+// vertical field of view vfov_rad and range_m, as horizontal distances [near_m, far_m]: from
+// h / tan(vfov / 2 - pitch) (0 when it sees straight down) to range_m, or nearer when the whole
+// field looks below the horizon. A level 45° camera 1.2 m up sees no floor nearer than 2.9 m.
+// An unknown field (0) or height: [0, range_m].
+struct FloorBand {
+  double near_m = 0.0, far_m = 0.0;
+};
+FloorBand VisibleFloor(double camera_height_m, double vfov_rad, double pitch_rad, double range_m);
+
+// The camera pitch for `view`: level, unless its target is unknown floor that a level camera
+// would not see (nearer than VisibleFloor's near_m); then tilted down just enough to bring the
+// target cell's near edge into the field of view. Within the robot's pitch limits.
+float ViewPitch(const omt::TaskView& view, const vp_robot& robot, double vfov_rad);
+
 // The task of standing at `view` with the base at theta_rad (the direction of travel), the
-// camera turned so it looks at the view's target, pitch level (within the robot's limits), in
-// the robot's current mode. tag = the view's target cell, so a later call can recognise it.
+// camera turned so it looks at the view's target, pitched by ViewPitch, in the robot's current
+// mode. tag = the view's target cell, so a later call can recognise it.
 vp_task TaskFromView(const omt::TaskView& view, double theta_rad, const vp_robot& robot,
-                     double dwell_s);
+                     double vfov_rad, double dwell_s);
 
 // Points of a view layer for the debug drawing: view positions at the robot's camera height.
 std::vector<float> ViewPointsXyz(const std::vector<omt::TaskView>& views, float z_m);

@@ -129,7 +129,7 @@ class OmtPlanner : public vp::Planner {
       const auto it = task_point.find(k);
       // The base arrives along the path; the camera joint turns to the view's target.
       const double theta = it != task_point.end() ? path[it->second].theta_rad : view.yaw_rad;
-      tasks.push_back(TaskFromView(view, theta, robot, options_.dwell_s));
+      tasks.push_back(TaskFromView(view, theta, robot, in.vfov_rad, options_.dwell_s));
       out.AddTask(r, tasks.back());
     }
     out.SetPath(r, path);

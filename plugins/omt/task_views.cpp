@@ -200,6 +200,8 @@ std::vector<TaskView> ExtractTaskViews(const OccupancyRaster& raster,
     view.yaw_rad = std::atan2(to_target.y(), to_target.x());
     view.cell = view_cell;
     view.target_cell = head.cell;
+    view.target_unknown = raster.At(head.cell) == Cell::kUnknown;
+    view.target_near_m = std::max(0.0, to_target.norm() - 0.5 * g.resolution_m);
     view.validness = validness;
     covered.clear();
     view.importance = ViewImportance(raster, view.position_m, view.yaw_rad, params, &covered);

@@ -38,9 +38,11 @@ std::vector<Candidate> CollectCandidates(const OccupancyRaster& raster,
 
 struct TaskView {
   Eigen::Vector2d position_m = Eigen::Vector2d::Zero();
-  double yaw_rad = 0.0;  // towards the target cell centre
-  int cell = -1;         // raster cell of the view position
-  int target_cell = -1;  // the queue head it was chosen for
+  double yaw_rad = 0.0;         // towards the target cell centre
+  int cell = -1;                // raster cell of the view position
+  int target_cell = -1;         // the queue head it was chosen for
+  bool target_unknown = false;  // the target is unknown floor (not a surface to rescan)
+  double target_near_m = 0.0;   // from the view to the near edge of the target cell
   float validness = 0.0f;
   double importance = 0.0;  // expected uncertainty reduction, in reference-cell units
 };

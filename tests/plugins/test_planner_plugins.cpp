@@ -283,6 +283,57 @@ TEST(Planners, DoneOnceAnIdleRobotLookedAtWhatStaysUnknown) {
   }
 }
 
+TEST(Planners, UnknownFloorTheCameraCannotSeeIsNeitherSettledNorViewedLevel) {
+  // The pocket of the test above, 2.0-2.3 m ahead, under a 45° vertical field of view (an Xtion)
+  // 1.2 m up: level, the camera sees no floor nearer than 2.9 m, so facing the pocket has not
+  // looked at it (not settled, not done); pitched 0.5 rad down it sees floor from 0.97 m on, so
+  // the same look settles it. A view sent to unknown floor tilts the camera just enough to see
+  // its target, and not at all where the level camera already does.
+  constexpr float kVfov = 0.785f;
+  auto narrow = [&](float theta, float pitch) {
+    test::RasterWorld world = RoomWithPocket(50, 15, 55, 25, theta);
+    for (ScanMode& m : world.robots()[0].modes) m.vertical_fov_rad = kVfov;
+    world.robots()[0].camera_pitch_rad = pitch;
+    return world;
+  };
+  for (const std::string& name : kPlanners) {
+    {
+      auto planner = MustLoad(name);
+      ASSERT_TRUE(planner);
+      EXPECT_FALSE(MustPlan(*planner, narrow(0.f, 0.f)).done) << name << ": settled unseen floor";
+    }
+    {
+      auto planner = MustLoad(name);
+      ASSERT_TRUE(planner);
+      EXPECT_TRUE(MustPlan(*planner, narrow(0.f, -0.5f)).done) << name;
+    }
+    for (const float vfov : {kVfov, 1.2f}) {
+      test::RasterWorld world = narrow(3.1416f, 0.f);
+      for (ScanMode& m : world.robots()[0].modes) m.vertical_fov_rad = vfov;
+      auto planner = MustLoad(name);
+      ASSERT_TRUE(planner);
+      const PlanResult r = MustPlan(*planner, world);
+      ASSERT_FALSE(r.robots[0].tasks.empty()) << name;
+      const PlannerFloor& floor = world.Floor();
+      const float h = world.robots()[0].camera_height_m;
+      for (const PlannerTask& t : r.robots[0].tasks) {
+        ASSERT_LT(t.tag, floor.cells.size());
+        const Eigen::Vector2f target = floor.CellCenter(int(t.tag % uint32_t(floor.width)),
+                                                        int(t.tag / uint32_t(floor.width)));
+        if (world.CellAt(target) != FloorCell::kUnknown) continue;  // a wall to rescan: level
+        const float d = (target - t.position_m).norm();
+        const float below = std::atan2(h, d);  // the target's floor below the horizon
+        EXPECT_LE(t.camera_pitch_rad, 0.f) << name;
+        EXPECT_LE(below, 0.5f * vfov - t.camera_pitch_rad + kAngleTol) << name << " d " << d;
+        // Level whenever a level camera sees the target's near edge.
+        if (std::atan2(h, d - 0.5f * floor.cell_size_m) <= 0.5f * vfov) {
+          EXPECT_EQ(t.camera_pitch_rad, 0.f) << name << " d " << d;
+        }
+      }
+    }
+  }
+}
+
 TEST(Planners, AFailedTaskSettlesNothingUntilTheRobotTakesAView) {
   // The pocket of the test above, 2 m ahead of a robot whose drive towards it was refused: it
   // stands where it stopped, facing the pocket, idle, and has not looked from any view. Neither
@@ -316,6 +367,7 @@ TEST(Planners, AFailedTaskSettlesNothingUntilTheRobotTakesAView) {
     world.robots()[0].position_m = view.position_m;
     world.robots()[0].theta_rad = view.theta_rad;
     world.robots()[0].camera_yaw_rad = view.camera_yaw_rad;
+    world.robots()[0].camera_pitch_rad = view.camera_pitch_rad;
     idle.call_index = 3;
     EXPECT_TRUE(MustPlan(*planner, world, idle).done) << name;
   }

@@ -101,6 +101,37 @@ TEST(Explore, SmallApartmentTerminatesWithTheFloorKnownAndTheSurfaceReconstructe
   EXPECT_GT(metrics->distance_total_m, 1.0);  // the robots did drive
 }
 
+TEST(Explore, ViewsTiltTheCameraTowardsUnknownFloorAndDriveLevel) {
+  // A 58° x 45° camera (an Xtion) 1.2 m up sees no floor nearer than 2.9 m when level: views of
+  // unknown floor tilt it down. OMT hands over a camera trajectory (level); on the move the
+  // camera follows it, not the last view's tilt.
+  ExploreParams params = FastParams();
+  params.robot.explorer.horizontal_fov_deg = 58.f;
+  params.robot.explorer.max_range_m = 3.f;
+  params.max_time_s = 120.0;
+  const Scene& s = SmallApartment();
+  Result<std::vector<Eigen::Vector2f>> starts =
+      ChooseStarts(s.plan, s.world.rooms, 2, params.robot.radius_m);
+  ASSERT_TRUE(starts.ok()) << starts.status().message();
+  Result<std::unique_ptr<LoadedPlanner>> omt =
+      LoadPlanner(VOXPLAN_OMT_TEST_PLANNER, {.config_json = "{}", .seed = 3, .search_path = {}});
+  ASSERT_TRUE(omt.ok()) << omt.status().message();
+  Result<ExploreResult> run = RunExplore(s.world, s.plan, *starts, **omt, params, {});
+  ASSERT_TRUE(run.ok()) << run.status().message();
+  int tilted = 0, moving = 0;
+  for (const RobotTrack& t : run->tracks) {
+    for (size_t k = 1; k < t.samples.size(); ++k) {
+      const RobotSample &a = t.samples[k - 1], &b = t.samples[k];
+      tilted += b.cam_pitch_rad < -1e-3;
+      if (a.x_m == b.x_m && a.y_m == b.y_m) continue;
+      ++moving;
+      EXPECT_EQ(b.cam_pitch_rad, 0.0) << t.robot << " at t=" << b.t_s;
+    }
+  }
+  EXPECT_GT(tilted, 0);
+  EXPECT_GT(moving, 0);
+}
+
 TEST(Explore, SameSeedGivesTheSameRun) {
   ExploreParams params = FastParams();
   params.max_time_s = 40.0;  // the start sweep and some driving
