@@ -261,8 +261,8 @@ void SettledCells::Update(const vp::WorldView& world, const WorldInput& input,
     const Eigen::Vector2d p = input.states[r].position_m;
     const int start = g.IndexOf(p);
     // Unknown floor was looked at only where the camera, at its pitch, saw the whole cell and
-    // the low end of its column: those voxels are seen on rays that meet the floor up to a
-    // tenth further on (0.1 m up, 1.2 m down), so the far end keeps a tenth to spare.
+    // the low end of its column: a voxel 0.1 m up, seen from 1.2 m, lies on a ray that meets
+    // the floor a tenth further on, so the far end keeps a tenth of the range to spare.
     constexpr double kColumnSeenFraction = 0.9;
     const FloorBand floor = VisibleFloor(input.robots[r].camera_height_m, input.vfov_rad,
                                          input.robots[r].camera_pitch_rad, sensor.d_max_m);
