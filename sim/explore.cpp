@@ -103,8 +103,10 @@ class Explorer {
   void CallPlanner(PlanEvent event, int32_t event_robot, const PlannerTask& failed);
   void Record(bool with_completeness);
   double DistanceTotal() const;
-  float CameraYawTarget(const RobotRun& r) const;
-  float CameraPitchTarget(const RobotRun& r) const;
+  struct CameraAim {
+    float yaw_rad, pitch_rad;  // camera yaw relative to the base; pitch
+  };
+  CameraAim CameraTarget(const RobotRun& r) const;
 
   const World& world_;
   const FloorPlan& plan_;
@@ -308,21 +310,14 @@ std::pair<float, float> TrajectoryYawPitch(const std::vector<CameraSample>& tr, 
   return {tr.back().yaw_rad, tr.back().pitch_rad};
 }
 
-float Explorer::CameraYawTarget(const RobotRun& r) const {
-  // Along the motion unless the plugin said where to look.
-  if (r.camera_trajectory.empty()) return 0.f;
-  const float world_yaw =
-      TrajectoryYawPitch(r.camera_trajectory, float(r.t_s - r.trajectory_t0_s)).first;
-  return WrapAngle(world_yaw - r.robot.state().heading_rad);
-}
-
-float Explorer::CameraPitchTarget(const RobotRun& r) const {
-  // Level unless the plugin said otherwise (a view may have tilted it), within the limits.
-  if (r.camera_trajectory.empty()) return 0.f;
-  const float pitch =
-      TrajectoryYawPitch(r.camera_trajectory, float(r.t_s - r.trajectory_t0_s)).second;
+Explorer::CameraAim Explorer::CameraTarget(const RobotRun& r) const {
+  // Along the motion and level unless the plugin said otherwise (a view may have tilted it).
+  if (r.camera_trajectory.empty()) return {0.f, 0.f};
+  const auto [world_yaw, pitch] =
+      TrajectoryYawPitch(r.camera_trajectory, float(r.t_s - r.trajectory_t0_s));
   const float max_pitch = Deg2Rad(r.robot.params().max_abs_pitch_deg);
-  return std::clamp(pitch, -max_pitch, max_pitch);
+  return {WrapAngle(world_yaw - r.robot.state().heading_rad),
+          std::clamp(pitch, -max_pitch, max_pitch)};
 }
 
 // One primitive at the view: turn the base, then the camera, then pitch, then dwell and capture.
@@ -402,15 +397,15 @@ Status Explorer::Advance(RobotRun& r, double t_end_s) {
       VOXPLAN_RETURN_IF_ERROR(AfterPrimitive(r, c));
       continue;
     }
-    const float dy = WrapAngle(CameraYawTarget(r) - s.camera_yaw_rad);
+    const CameraAim aim = CameraTarget(r);
+    const float dy = WrapAngle(aim.yaw_rad - s.camera_yaw_rad);
     if (std::abs(dy) > Deg2Rad(2.f)) {
       r.robot.SetCameraYaw(s.camera_yaw_rad + Clamp(dy, turn_step));
       VOXPLAN_RETURN_IF_ERROR(AfterPrimitive(r, c));
       continue;
     }
-    const float pitch = CameraPitchTarget(r);
-    if (std::abs(pitch - s.camera_pitch_rad) > 1e-3f) {
-      VOXPLAN_RETURN_IF_ERROR(r.robot.SetCameraPitch(pitch));
+    if (std::abs(aim.pitch_rad - s.camera_pitch_rad) > 1e-3f) {
+      VOXPLAN_RETURN_IF_ERROR(r.robot.SetCameraPitch(aim.pitch_rad));
       VOXPLAN_RETURN_IF_ERROR(AfterPrimitive(r, c));
       continue;
     }

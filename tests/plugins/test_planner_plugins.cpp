@@ -290,9 +290,9 @@ TEST(Planners, UnknownFloorTheCameraCannotSeeIsNeitherSettledNorViewedLevel) {
   // the same look settles it. A view sent to unknown floor tilts the camera just enough to see
   // its target, and not at all where the level camera already does.
   constexpr float kVfov = 0.785f;
-  auto narrow = [&](float theta, float pitch) {
+  auto narrow = [](float theta, float pitch, float vfov) {
     test::RasterWorld world = RoomWithPocket(50, 15, 55, 25, theta);
-    for (ScanMode& m : world.robots()[0].modes) m.vertical_fov_rad = kVfov;
+    for (ScanMode& m : world.robots()[0].modes) m.vertical_fov_rad = vfov;
     world.robots()[0].camera_pitch_rad = pitch;
     return world;
   };
@@ -300,16 +300,16 @@ TEST(Planners, UnknownFloorTheCameraCannotSeeIsNeitherSettledNorViewedLevel) {
     {
       auto planner = MustLoad(name);
       ASSERT_TRUE(planner);
-      EXPECT_FALSE(MustPlan(*planner, narrow(0.f, 0.f)).done) << name << ": settled unseen floor";
+      EXPECT_FALSE(MustPlan(*planner, narrow(0.f, 0.f, kVfov)).done)
+          << name << ": settled unseen floor";
     }
     {
       auto planner = MustLoad(name);
       ASSERT_TRUE(planner);
-      EXPECT_TRUE(MustPlan(*planner, narrow(0.f, -0.5f)).done) << name;
+      EXPECT_TRUE(MustPlan(*planner, narrow(0.f, -0.5f, kVfov)).done) << name;
     }
     for (const float vfov : {kVfov, 1.2f}) {
-      test::RasterWorld world = narrow(3.1416f, 0.f);
-      for (ScanMode& m : world.robots()[0].modes) m.vertical_fov_rad = vfov;
+      test::RasterWorld world = narrow(3.1416f, 0.f, vfov);
       auto planner = MustLoad(name);
       ASSERT_TRUE(planner);
       const PlanResult r = MustPlan(*planner, world);
