@@ -97,6 +97,11 @@ const char* KernelName(Kernel kernel) {
 
 namespace {
 
+// Finite readings beyond max depth clear the free space in front of it.
+bool ClearsBeyond(const IntegrateParams& params) {
+  return params.carve_free_space && params.clear_beyond_max_depth;
+}
+
 // Carving ray tiles: square, small enough that rays through neighbouring tile corners are at
 // most carve_ray_spacing_blocks apart at max depth, and at most 64 pixels.
 int CarveTileSide(const PinholeCamera& camera, const IntegrateParams& params,
@@ -224,6 +229,8 @@ std::vector<BlockIndex> CollectBlocks(const DepthImage& depth, const PinholeCame
     // it vectorises), then per tile over its columns.
     std::vector<float> tile_max(size_t(tiles_u) * size_t(tiles_v), 0.f);
     const float lo = params.min_depth_m, hi = params.max_depth_m;
+    // A reading beyond max depth that clears carves up to max depth (ClearsBeyond).
+    const float clear = ClearsBeyond(params) ? std::numeric_limits<float>::max() : 0.f;
     ParallelFor(size_t(tiles_v), 1, [&](size_t begin, size_t end) {
       std::vector<float> column_max(size_t(depth.width));
       for (size_t tv = begin; tv < end; ++tv) {
@@ -234,7 +241,7 @@ std::vector<BlockIndex> CollectBlocks(const DepthImage& depth, const PinholeCame
           float* __restrict cm = column_max.data();
           for (int u = 0; u < depth.width; ++u) {
             const float d = depth_row[u];
-            const float x = ((d >= lo) & (d <= hi)) ? d : 0.f;
+            const float x = ((d >= lo) & (d <= hi)) ? d : ((d >= lo) & (d <= clear)) ? hi : 0.f;
             cm[u] = cm[u] > x ? cm[u] : x;
           }
         }
@@ -394,6 +401,7 @@ Result<IntegrateStats> IntegrateFrame(const DepthImage& depth, const ColorImage&
   }
   f.min_depth_m = params.min_depth_m;
   f.max_depth_m = params.max_depth_m;
+  f.clear_depth_m = ClearsBeyond(params) ? std::numeric_limits<float>::max() : 0.f;
   f.trunc_m = volume.trunc_m();
   f.inv_trunc = 1.0f / volume.trunc_m();
   f.voxel_size_m = volume.voxel_size_m();

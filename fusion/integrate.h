@@ -32,6 +32,11 @@ struct IntegrateParams {
   // tiles (out to the tiles' farthest depth plus the truncation), tiles small enough that
   // neighbouring rays are at most this many blocks apart at max depth.
   float carve_ray_spacing_blocks = 0.25f;
+  // With carving: a (finite) reading beyond max_depth_m is not fused as a surface, but the
+  // free space it shows in front of max_depth_m is, as a laser's max-range beam clears
+  // (OctoMap's maxrange). Real sensors return such readings; their noise keeps them out of the
+  // model.
+  bool clear_beyond_max_depth = false;
 };
 
 struct IntegrateStats {

@@ -27,7 +27,9 @@ void IntegrateBlockScalar(const FrameView& f, BlockIndex index, TsdfBlock& block
         if (!(uf >= 0.0f && uf < float(f.width) && vf >= 0.0f && vf < float(f.height))) continue;
         const int pixel = int(vf) * f.width + int(uf);
         const float d = f.depth[pixel];
-        if (!(d >= f.min_depth_m && d <= f.max_depth_m)) continue;
+        const bool in_range = d <= f.max_depth_m;
+        if (!(d >= f.min_depth_m && (in_range || (d <= f.clear_depth_m && cz_ <= f.max_depth_m))))
+          continue;
         const float sdf = d - cz_;
         if (!(sdf >= -f.trunc_m)) continue;
         const float tsdf = std::min(1.0f, sdf * f.inv_trunc);
@@ -44,7 +46,7 @@ void IntegrateBlockScalar(const FrameView& f, BlockIndex index, TsdfBlock& block
             int16_t(std::nearbyint(std::min(std::max(new_t, -1.0f), 1.0f) * kTsdfScale));
         block.weight[i] = uint16_t(std::nearbyint(new_w * kWeightScale));
         // Colour only inside the band: farther voxels see free space, not this surface.
-        if (f.color && sdf < f.trunc_m) {
+        if (f.color && sdf < f.trunc_m && in_range) {
           const uint32_t c = f.color[pixel];
           const float obs[3] = {float(c & 0xff), float((c >> 8) & 0xff), float((c >> 16) & 0xff)};
           uint8_t* ch[3] = {&block.r[i], &block.g[i], &block.b[i]};

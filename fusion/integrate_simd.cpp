@@ -56,6 +56,7 @@ VOXPLAN_AVX2 void UpdateBlock(const FrameView& f, BlockIndex index, TsdfBlock& b
   const float* const depth = f.depth;
   const uint32_t* const color = f.color;
   const bool depth_weighting = f.depth_weighting;
+  const bool clearing = f.clear_depth_m > f.max_depth_m;
   const __m256 lane = _mm256_setr_ps(0.5f, 1.5f, 2.5f, 3.5f, 4.5f, 5.5f, 6.5f, 7.5f);
   const __m256 px = _mm256_add_ps(Splat(ox), _mm256_mul_ps(lane, Splat(s)));
   // The x terms of the projection, the same for every row of the block.
@@ -77,6 +78,7 @@ VOXPLAN_AVX2 void UpdateBlock(const FrameView& f, BlockIndex index, TsdfBlock& b
   const __m256 half = Splat(0.5f);
   const __m256 max_u = Splat(float(f.width)), max_v = Splat(float(f.height));
   const __m256 min_d = Splat(f.min_depth_m), max_d = Splat(f.max_depth_m);
+  const __m256 clear_d = Splat(f.clear_depth_m);
   const __m256 trunc = Splat(f.trunc_m), minus_trunc = Splat(-f.trunc_m);
   const __m256 inv_trunc = Splat(f.inv_trunc), max_weight = Splat(f.max_weight);
   const __m256 inv_tsdf_scale = Splat(1.0f / kTsdfScale), inv_w_scale = Splat(1.0f / kWeightScale);
@@ -103,11 +105,12 @@ VOXPLAN_AVX2 void UpdateBlock(const FrameView& f, BlockIndex index, TsdfBlock& b
           _mm256_add_ps(_mm256_add_ps(_mm256_mul_ps(_mm256_mul_ps(fy, cy_), inv_z), cy), half);
       __m256i pixel = _mm256_add_epi32(_mm256_mullo_epi32(_mm256_cvttps_epi32(vf), width),
                                        _mm256_cvttps_epi32(uf));
-      __m256 d;
+      __m256 d, in_range, in_view;  // in_view: the lanes that project into the image
       if constexpr (kInside) {
         d = _mm256_i32gather_ps(depth, pixel, 4);
-        valid =
-            _mm256_and_ps(_mm256_cmp_ps(d, min_d, _CMP_GE_OQ), _mm256_cmp_ps(d, max_d, _CMP_LE_OQ));
+        in_view = _mm256_castsi256_ps(_mm256_set1_epi32(-1));
+        in_range = _mm256_cmp_ps(d, max_d, _CMP_LE_OQ);
+        valid = _mm256_and_ps(_mm256_cmp_ps(d, min_d, _CMP_GE_OQ), in_range);
       } else {
         valid = _mm256_and_ps(valid, _mm256_cmp_ps(uf, zero, _CMP_GE_OQ));
         valid = _mm256_and_ps(valid, _mm256_cmp_ps(uf, max_u, _CMP_LT_OQ));
@@ -117,8 +120,16 @@ VOXPLAN_AVX2 void UpdateBlock(const FrameView& f, BlockIndex index, TsdfBlock& b
         // Invalid lanes gather pixel 0 (masked off anyway) so no index is out of range.
         pixel = _mm256_and_si256(pixel, _mm256_castps_si256(valid));
         d = _mm256_mask_i32gather_ps(zero, depth, pixel, valid, 4);
+        in_view = valid;
         valid = _mm256_and_ps(valid, _mm256_cmp_ps(d, min_d, _CMP_GE_OQ));
-        valid = _mm256_and_ps(valid, _mm256_cmp_ps(d, max_d, _CMP_LE_OQ));
+        in_range = _mm256_cmp_ps(d, max_d, _CMP_LE_OQ);
+        valid = _mm256_and_ps(valid, in_range);
+      }
+      if (clearing) {  // as the scalar kernel: beyond max depth, free space up to it
+        const __m256 clears = _mm256_and_ps(_mm256_cmp_ps(d, clear_d, _CMP_LE_OQ),
+                                            _mm256_cmp_ps(cz_, max_d, _CMP_LE_OQ));
+        valid = _mm256_or_ps(valid, _mm256_and_ps(_mm256_and_ps(in_view, clears),
+                                                  _mm256_cmp_ps(d, min_d, _CMP_GE_OQ)));
       }
       const __m256 sdf = _mm256_sub_ps(d, cz_);
       valid = _mm256_and_ps(valid, _mm256_cmp_ps(sdf, minus_trunc, _CMP_GE_OQ));
@@ -150,7 +161,8 @@ VOXPLAN_AVX2 void UpdateBlock(const FrameView& f, BlockIndex index, TsdfBlock& b
                        _mm_blendv_epi8(old_w16, PackI32ToU16(w32), mask16));
 
       if (!color) continue;
-      const __m256 cmask = _mm256_and_ps(valid, _mm256_cmp_ps(sdf, trunc, _CMP_LT_OQ));
+      const __m256 cmask =
+          _mm256_and_ps(_mm256_and_ps(valid, in_range), _mm256_cmp_ps(sdf, trunc, _CMP_LT_OQ));
       if (_mm256_testz_ps(cmask, cmask)) continue;
       const __m256i c =
           _mm256_mask_i32gather_epi32(_mm256_setzero_si256(), reinterpret_cast<const int*>(color),

@@ -136,7 +136,8 @@ Status Explorer::Fuse(RobotRun& r, bool force) {
   if (!r.trigger.ShouldFuse(T_W_C) && !force) return Status::Ok();
   const PinholeCamera camera = r.robot.camera();
   RenderParams rp;
-  rp.max_range_m = r.robot.mode_params().max_range_m;
+  // Clearing needs the readings beyond the range: the sensor returns them, unlimited here.
+  rp.max_range_m = p_.clear_beyond_range ? 0.f : r.robot.mode_params().max_range_m;
   rp.color = p_.fuse_color;
   rp.labels = p_.fuse_labels;
   rp.normals = p_.noise;
@@ -157,6 +158,7 @@ Status Explorer::Fuse(RobotRun& r, bool force) {
   IntegrateParams ip;
   ip.min_depth_m = 0.1f;
   ip.max_depth_m = r.robot.mode_params().max_range_m;
+  ip.clear_beyond_max_depth = p_.clear_beyond_range;
   ip.integrate_color = p_.fuse_color;
   t0 = NowMs();
   Result<PlanningFrameStats> stats =

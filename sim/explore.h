@@ -53,11 +53,16 @@ struct ExploreParams {
   // Vertex colours of the final mesh only (no metric reads them): off saves rendering and
   // fusing colour, about a tenth of a frame's cost.
   bool fuse_color = true;
+  // Depth beyond the camera's range is too noisy to fuse as surface but still shows the free
+  // space in front of the range: cleared there. Without it, a short-range camera leaves open
+  // floor unknown wherever the walls lie beyond its range.
+  bool clear_beyond_range = true;
   FusionTriggerParams trigger = {0.25f, 15.0f};
   RobotParams robot;  // image size above overrides robot.image_*
   // The floor map's band reaches 0.6 m above the camera; beyond ~2.5 m the rays through its top
-  // meet the ceiling past the sensor's range and carve nothing, so a column there is never 90 %
-  // observed. Free from 60 % on: the lower band, where furniture stands, must be seen.
+  // meet the ceiling past the sensor's range and carve only by clearing (clear_beyond_range), so
+  // a column there is rarely 90 % observed. Free from 60 % on: the lower band, where furniture
+  // stands, must be seen.
   FloorMapParams floor = {.min_free_fraction = 0.6f, .voxel_state = {}};
 
   // The loop.

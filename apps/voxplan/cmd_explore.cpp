@@ -71,6 +71,7 @@ struct ExploreOptions {
   bool no_noise = false;
   bool no_labels = false;
   bool no_color = false;
+  bool no_clear = false;
   double planning_interval = 15.0;
   double plan_budget = 1.0;
   double eval_samples_per_m2 = 100.0;
@@ -236,6 +237,7 @@ int RunExploreCommand(const ExploreOptions& o) {
   params.noise = !o.no_noise;
   params.fuse_labels = !o.no_labels;
   params.fuse_color = !o.no_color;
+  params.clear_beyond_range = !o.no_clear;
   params.planning_interval_s = o.planning_interval;
   params.plan_time_budget_s = o.plan_budget;
   params.max_time_s = o.max_time;
@@ -482,6 +484,9 @@ Command AddExploreCommand(CLI::App& app) {
                   "Depth range of the explorer camera, metres (the paper's Xtion: 3)")
       ->capture_default_str();
   sub->add_flag("--no-noise", o->no_noise, "Fuse clean rendered depth (no Kinect noise)");
+  sub->add_flag("--no-clear-beyond-range", o->no_clear,
+                "Depth beyond --max-range-m clears nothing (by default it clears the free space in "
+                "front of the range, as a real sensor's far returns show it)");
   sub->add_flag("--no-labels", o->no_labels, "Fuse no instance labels (no object map)");
   sub->add_flag("--no-color", o->no_color,
                 "Render and fuse no colour (a grey mesh.ply; the metrics do not change)");

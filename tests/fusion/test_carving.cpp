@@ -2,7 +2,9 @@
 // list, the coverage of the subsampled carving rays, and scalar vs SIMD parity with carving on.
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <cstring>
+#include <limits>
 
 #include "core/parallel.h"
 #include "core/voxel_state.h"
@@ -126,10 +128,17 @@ TEST(Carving, TileRaysReachNearlyEveryVoxelTheFrameObserves) {
 TEST(Carving, ScalarAndSimdKernelsAgreeBitForBit) {
   if (!SimdKernelAvailable()) GTEST_SKIP() << "no AVX2 on this CPU";
   const PinholeCamera cam = test::RoomCamera(120);
-  for (Weighting weighting : {Weighting::kConstant, Weighting::kDepthDependent}) {
+  // The last case cuts the room with its range: readings on both sides of it, the far ones
+  // clearing.
+  for (int c = 0; c < 3; ++c) {
+    const Weighting weighting = c == 1 ? Weighting::kDepthDependent : Weighting::kConstant;
     TsdfVolume scalar({kVoxel, kTrunc}), simd({kVoxel, kTrunc});
     IntegrateParams params = CarveParams();
     params.weighting = weighting;
+    if (c == 2) {
+      params.max_depth_m = 1.3f;
+      params.clear_beyond_max_depth = true;
+    }
     for (const Pose3f& pose : test::AxisViews(kEye)) {
       DepthImage depth = test::RenderRoomDepth(kRoom, cam, pose);
       for (size_t i = 0; i < depth.data.size(); i += 37) depth.data[i] = 0.f;  // dropouts
@@ -144,6 +153,52 @@ TEST(Carving, ScalarAndSimdKernelsAgreeBitForBit) {
     scalar.ForEachBlock([&](BlockIndex b, const TsdfBlock& sb) {
       EXPECT_EQ(std::memcmp(&sb, simd.FindBlock(b), sizeof(TsdfBlock)), 0);
     });
+  }
+}
+
+// Every wall of kRoom lies at least 0.89 m (z-depth) from kEye: with a 0.8 m range a frame sees
+// nothing to fuse, only free space in front of the range, and only when readings beyond the range
+// clear.
+TEST(Carving, ReadingsBeyondMaxDepthClearFreeSpaceInFrontOfIt) {
+  const PinholeCamera cam = test::RoomCamera();
+  const Pose3f pose = test::AxisViews(kEye)[0];  // along +x
+  const DepthImage depth = test::RenderRoomDepth(kRoom, cam, pose);
+  ColorImage color(cam.width, cam.height, 0x00ffffffu);
+  const GlobalVoxelIndex ahead = VoxelAt(Eigen::Vector3f(0.5f, 0.03f, 0.01f), kVoxel);
+  for (bool clear : {false, true}) {
+    TsdfVolume volume({kVoxel, kTrunc});
+    IntegrateParams params = CarveParams();
+    params.max_depth_m = 0.8f;
+    params.clear_beyond_max_depth = clear;
+    ASSERT_TRUE(IntegrateFrame(depth, color, cam, pose, params, volume).ok());
+    EXPECT_EQ(Observed(volume, ahead), clear);
+    size_t observed = 0;
+    const Pose3f T_C_W = pose.inverse();
+    volume.ForEachBlock([&](BlockIndex b, const TsdfBlock& block) {
+      for (int i = 0; i < kBlockVoxels; ++i) {
+        if (block.weight[i] == 0) continue;
+        ++observed;
+        // Free and colourless: a reading beyond the range is no surface, and nothing beyond
+        // the range is touched.
+        EXPECT_EQ(block.tsdf[i], int16_t(kTsdfScale));
+        EXPECT_EQ(block.r[i] | block.g[i] | block.b[i], 0);
+        const VoxelIndex local{i & kBlockMask, (i >> kBlockShift) & kBlockMask,
+                               i >> (2 * kBlockShift)};
+        const Eigen::Vector3f p_W = VoxelCenter(GlobalOf(b, local), kVoxel);
+        EXPECT_LE((T_C_W * p_W).z(), params.max_depth_m + 1e-4f);
+      }
+    });
+    EXPECT_EQ(observed > 0, clear);
+  }
+  // Readings that are not finite distances clear nothing.
+  for (float bad : {std::numeric_limits<float>::infinity(), std::nanf("")}) {
+    TsdfVolume volume({kVoxel, kTrunc});
+    IntegrateParams params = CarveParams();
+    params.max_depth_m = 0.8f;
+    params.clear_beyond_max_depth = true;
+    const DepthImage bad_depth(cam.width, cam.height, bad);
+    ASSERT_TRUE(IntegrateFrame(bad_depth, {}, cam, pose, params, volume).ok());
+    EXPECT_FALSE(Observed(volume, ahead));
   }
 }
 
