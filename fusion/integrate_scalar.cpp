@@ -36,6 +36,9 @@ void IntegrateBlockScalar(const FrameView& f, BlockIndex index, TsdfBlock& block
         const float w_obs = f.depth_weighting ? 1.0f / (d * d) : 1.0f;
 
         const int i = LinearIndex(x, y, z);
+        // A reading beyond the range clears only what is unobserved or free: its noise must not
+        // erase a surface that readings in range put there.
+        if (!in_range && block.tsdf[i] != int16_t(kTsdfScale)) continue;
         const float old_t = float(block.tsdf[i]) * (1.0f / kTsdfScale);
         const float old_w = float(block.weight[i]) * (1.0f / kWeightScale);
         const float sum_w = old_w + w_obs;

@@ -141,6 +141,12 @@ VOXPLAN_AVX2 void UpdateBlock(const FrameView& f, BlockIndex index, TsdfBlock& b
       const int i = LinearIndex(0, y, z);
       const __m128i old_t16 = _mm_loadu_si128(reinterpret_cast<const __m128i*>(&block.tsdf[i]));
       const __m128i old_w16 = _mm_loadu_si128(reinterpret_cast<const __m128i*>(&block.weight[i]));
+      if (clearing) {  // as the scalar kernel: clearing leaves surfaces alone
+        const __m256 free = _mm256_castsi256_ps(_mm256_cmpeq_epi32(
+            _mm256_cvtepi16_epi32(old_t16), _mm256_set1_epi32(int32_t(kTsdfScale))));
+        valid = _mm256_and_ps(valid, _mm256_or_ps(in_range, free));
+        if (_mm256_testz_ps(valid, valid)) continue;
+      }
       const __m256 old_t =
           _mm256_mul_ps(_mm256_cvtepi32_ps(_mm256_cvtepi16_epi32(old_t16)), inv_tsdf_scale);
       const __m256 old_w =

@@ -202,6 +202,43 @@ TEST(Carving, ReadingsBeyondMaxDepthClearFreeSpaceInFrontOfIt) {
   }
 }
 
+// Far returns add free space; they never erase a surface that readings in range put there (a
+// thin leg seen up close would otherwise fade under the rays that pass it to a far wall).
+TEST(Carving, ClearingLeavesFusedSurfacesAlone) {
+  const PinholeCamera cam = test::RoomCamera();
+  const Pose3f pose =
+      LookAt(Eigen::Vector3f(1.0f, 0.03f, 0.01f), Eigen::Vector3f(2.f, 0.03f, 0.01f));
+  TsdfVolume volume({kVoxel, kTrunc}), before({kVoxel, kTrunc});
+  IntegrateParams params = CarveParams();
+  const DepthImage near_depth = test::RenderRoomDepth(kRoom, cam, pose);
+  for (TsdfVolume* v : {&volume, &before})
+    ASSERT_TRUE(IntegrateFrame(near_depth, {}, cam, pose, params, *v).ok());
+  // The wall 0.49 m ahead, then a frame whose returns all lie beyond a 2 m range (a room with
+  // its walls 3 m off or more): it clears through where the wall was fused.
+  const test::BoxRoom far_room{Eigen::Vector3f::Constant(-4.f), Eigen::Vector3f::Constant(4.f)};
+  params.max_depth_m = 2.f;
+  params.clear_beyond_max_depth = true;
+  ASSERT_TRUE(
+      IntegrateFrame(test::RenderRoomDepth(far_room, cam, pose), {}, cam, pose, params, volume)
+          .ok());
+  size_t surface = 0, cleared = 0;
+  before.ForEachBlock([&](BlockIndex b, const TsdfBlock& old) {
+    const TsdfBlock& now = *volume.FindBlock(b);
+    for (int i = 0; i < kBlockVoxels; ++i) {
+      if (old.weight[i] == 0) continue;
+      if (old.tsdf[i] != int16_t(kTsdfScale)) {
+        ++surface;  // near or behind the wall: untouched
+        EXPECT_EQ(now.tsdf[i], old.tsdf[i]);
+        EXPECT_EQ(now.weight[i], old.weight[i]);
+      } else {
+        cleared += now.weight[i] > old.weight[i];
+      }
+    }
+  });
+  EXPECT_GT(surface, 100u);
+  EXPECT_GT(cleared, 100u);
+}
+
 TEST(Carving, RefusesANonPositiveRaySpacing) {
   const PinholeCamera cam = test::RoomCamera();
   const Pose3f pose = test::AxisViews(kEye)[0];
