@@ -35,7 +35,7 @@ struct IntegrateParams {
   // With carving: a (finite) reading beyond max_depth_m is not fused as a surface, but the
   // free space it shows in front of max_depth_m is, as a laser's max-range beam clears
   // (OctoMap's maxrange). Real sensors return such readings; their noise keeps them out of the
-  // model.
+  // model, so they update only voxels still unobserved or free, never a fused surface.
   bool clear_beyond_max_depth = false;
 };
 

@@ -20,8 +20,8 @@ struct FrameView {
   float r[9];  // R_C_W row-major
   float t[3];  // t_C_W
   float min_depth_m = 0, max_depth_m = 0;
-  // Readings in (max_depth_m, clear_depth_m] update the voxels up to max_depth_m only (as free
-  // space); clear_depth_m <= max_depth_m: none.
+  // Readings in (max_depth_m, clear_depth_m] update the voxels up to max_depth_m only, and of
+  // those only the unobserved or free ones (stored +1); clear_depth_m <= max_depth_m: none.
   float clear_depth_m = 0;
   float trunc_m = 0, inv_trunc = 0;
   float voxel_size_m = 0;

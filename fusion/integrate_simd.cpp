@@ -105,12 +105,10 @@ VOXPLAN_AVX2 void UpdateBlock(const FrameView& f, BlockIndex index, TsdfBlock& b
           _mm256_add_ps(_mm256_add_ps(_mm256_mul_ps(_mm256_mul_ps(fy, cy_), inv_z), cy), half);
       __m256i pixel = _mm256_add_epi32(_mm256_mullo_epi32(_mm256_cvttps_epi32(vf), width),
                                        _mm256_cvttps_epi32(uf));
-      __m256 d, in_range, in_view;  // in_view: the lanes that project into the image
+      __m256 d, in_view;  // in_view: the lanes that project into the image
       if constexpr (kInside) {
         d = _mm256_i32gather_ps(depth, pixel, 4);
         in_view = _mm256_castsi256_ps(_mm256_set1_epi32(-1));
-        in_range = _mm256_cmp_ps(d, max_d, _CMP_LE_OQ);
-        valid = _mm256_and_ps(_mm256_cmp_ps(d, min_d, _CMP_GE_OQ), in_range);
       } else {
         valid = _mm256_and_ps(valid, _mm256_cmp_ps(uf, zero, _CMP_GE_OQ));
         valid = _mm256_and_ps(valid, _mm256_cmp_ps(uf, max_u, _CMP_LT_OQ));
@@ -121,15 +119,14 @@ VOXPLAN_AVX2 void UpdateBlock(const FrameView& f, BlockIndex index, TsdfBlock& b
         pixel = _mm256_and_si256(pixel, _mm256_castps_si256(valid));
         d = _mm256_mask_i32gather_ps(zero, depth, pixel, valid, 4);
         in_view = valid;
-        valid = _mm256_and_ps(valid, _mm256_cmp_ps(d, min_d, _CMP_GE_OQ));
-        in_range = _mm256_cmp_ps(d, max_d, _CMP_LE_OQ);
-        valid = _mm256_and_ps(valid, in_range);
       }
+      const __m256 seen = _mm256_and_ps(in_view, _mm256_cmp_ps(d, min_d, _CMP_GE_OQ));
+      const __m256 in_range = _mm256_cmp_ps(d, max_d, _CMP_LE_OQ);
+      valid = _mm256_and_ps(seen, in_range);
       if (clearing) {  // as the scalar kernel: beyond max depth, free space up to it
         const __m256 clears = _mm256_and_ps(_mm256_cmp_ps(d, clear_d, _CMP_LE_OQ),
                                             _mm256_cmp_ps(cz_, max_d, _CMP_LE_OQ));
-        valid = _mm256_or_ps(valid, _mm256_and_ps(_mm256_and_ps(in_view, clears),
-                                                  _mm256_cmp_ps(d, min_d, _CMP_GE_OQ)));
+        valid = _mm256_or_ps(valid, _mm256_and_ps(seen, clears));
       }
       const __m256 sdf = _mm256_sub_ps(d, cz_);
       valid = _mm256_and_ps(valid, _mm256_cmp_ps(sdf, minus_trunc, _CMP_GE_OQ));
