@@ -45,10 +45,12 @@ bool CentresProjectInside(const FrameView& f, float ox, float oy, float oz) {
   return true;
 }
 
-// The kernel; kInside: CentresProjectInside holds, so no lane needs the bounds checks. Frame
-// values are copied into locals first: the colour stores (uint8_t) may alias anything, and
-// would otherwise make the compiler reload them from `f` on every row.
-template <bool kInside>
+// The kernel; kInside: CentresProjectInside holds, so no lane needs the bounds checks;
+// kClearing: readings beyond max depth clear (FrameView::clear_depth_m), a separate copy so that
+// the usual path carries none of it. Frame values are copied into locals first: the colour stores
+// (uint8_t) may alias anything, and would otherwise make the compiler reload them from `f` on
+// every row.
+template <bool kInside, bool kClearing>
 VOXPLAN_AVX2 void UpdateBlock(const FrameView& f, BlockIndex index, TsdfBlock& block) {
   const float s = f.voxel_size_m;
   const float ox = float(index.x * kBlockSide) * s, oy = float(index.y * kBlockSide) * s,
@@ -56,7 +58,6 @@ VOXPLAN_AVX2 void UpdateBlock(const FrameView& f, BlockIndex index, TsdfBlock& b
   const float* const depth = f.depth;
   const uint32_t* const color = f.color;
   const bool depth_weighting = f.depth_weighting;
-  const bool clearing = f.clear_depth_m > f.max_depth_m;
   const __m256 lane = _mm256_setr_ps(0.5f, 1.5f, 2.5f, 3.5f, 4.5f, 5.5f, 6.5f, 7.5f);
   const __m256 px = _mm256_add_ps(Splat(ox), _mm256_mul_ps(lane, Splat(s)));
   // The x terms of the projection, the same for every row of the block.
@@ -105,10 +106,9 @@ VOXPLAN_AVX2 void UpdateBlock(const FrameView& f, BlockIndex index, TsdfBlock& b
           _mm256_add_ps(_mm256_add_ps(_mm256_mul_ps(_mm256_mul_ps(fy, cy_), inv_z), cy), half);
       __m256i pixel = _mm256_add_epi32(_mm256_mullo_epi32(_mm256_cvttps_epi32(vf), width),
                                        _mm256_cvttps_epi32(uf));
-      __m256 d, in_view;  // in_view: the lanes that project into the image
+      __m256 d;
       if constexpr (kInside) {
         d = _mm256_i32gather_ps(depth, pixel, 4);
-        in_view = _mm256_castsi256_ps(_mm256_set1_epi32(-1));
       } else {
         valid = _mm256_and_ps(valid, _mm256_cmp_ps(uf, zero, _CMP_GE_OQ));
         valid = _mm256_and_ps(valid, _mm256_cmp_ps(uf, max_u, _CMP_LT_OQ));
@@ -118,12 +118,13 @@ VOXPLAN_AVX2 void UpdateBlock(const FrameView& f, BlockIndex index, TsdfBlock& b
         // Invalid lanes gather pixel 0 (masked off anyway) so no index is out of range.
         pixel = _mm256_and_si256(pixel, _mm256_castps_si256(valid));
         d = _mm256_mask_i32gather_ps(zero, depth, pixel, valid, 4);
-        in_view = valid;
       }
-      const __m256 seen = _mm256_and_ps(in_view, _mm256_cmp_ps(d, min_d, _CMP_GE_OQ));
+      // Lanes with a reading (in the image, not too near), then those fused as usual.
+      __m256 seen = _mm256_cmp_ps(d, min_d, _CMP_GE_OQ);
+      if constexpr (!kInside) seen = _mm256_and_ps(valid, seen);
       const __m256 in_range = _mm256_cmp_ps(d, max_d, _CMP_LE_OQ);
       valid = _mm256_and_ps(seen, in_range);
-      if (clearing) {  // as the scalar kernel: beyond max depth, free space up to it
+      if constexpr (kClearing) {  // as the scalar kernel: beyond max depth, free space up to it
         const __m256 clears = _mm256_and_ps(_mm256_cmp_ps(d, clear_d, _CMP_LE_OQ),
                                             _mm256_cmp_ps(cz_, max_d, _CMP_LE_OQ));
         valid = _mm256_or_ps(valid, _mm256_and_ps(seen, clears));
@@ -138,7 +139,7 @@ VOXPLAN_AVX2 void UpdateBlock(const FrameView& f, BlockIndex index, TsdfBlock& b
       const int i = LinearIndex(0, y, z);
       const __m128i old_t16 = _mm_loadu_si128(reinterpret_cast<const __m128i*>(&block.tsdf[i]));
       const __m128i old_w16 = _mm_loadu_si128(reinterpret_cast<const __m128i*>(&block.weight[i]));
-      if (clearing) {  // as the scalar kernel: clearing leaves surfaces alone
+      if constexpr (kClearing) {  // as the scalar kernel: clearing leaves surfaces alone
         const __m256 free = _mm256_castsi256_ps(_mm256_cmpeq_epi32(
             _mm256_cvtepi16_epi32(old_t16), _mm256_set1_epi32(int32_t(kTsdfScale))));
         valid = _mm256_and_ps(valid, _mm256_or_ps(in_range, free));
@@ -164,8 +165,8 @@ VOXPLAN_AVX2 void UpdateBlock(const FrameView& f, BlockIndex index, TsdfBlock& b
                        _mm_blendv_epi8(old_w16, PackI32ToU16(w32), mask16));
 
       if (!color) continue;
-      const __m256 cmask =
-          _mm256_and_ps(_mm256_and_ps(valid, in_range), _mm256_cmp_ps(sdf, trunc, _CMP_LT_OQ));
+      __m256 cmask = _mm256_and_ps(valid, _mm256_cmp_ps(sdf, trunc, _CMP_LT_OQ));
+      if constexpr (kClearing) cmask = _mm256_and_ps(cmask, in_range);
       if (_mm256_testz_ps(cmask, cmask)) continue;
       const __m256i c =
           _mm256_mask_i32gather_epi32(_mm256_setzero_si256(), reinterpret_cast<const int*>(color),
@@ -193,11 +194,18 @@ VOXPLAN_AVX2 void UpdateBlock(const FrameView& f, BlockIndex index, TsdfBlock& b
 
 VOXPLAN_AVX2 void IntegrateBlockSimd(const FrameView& f, BlockIndex index, TsdfBlock& block) {
   const float s = f.voxel_size_m;
-  if (CentresProjectInside(f, float(index.x * kBlockSide) * s, float(index.y * kBlockSide) * s,
-                           float(index.z * kBlockSide) * s))
-    UpdateBlock<true>(f, index, block);
+  const bool inside =
+      CentresProjectInside(f, float(index.x * kBlockSide) * s, float(index.y * kBlockSide) * s,
+                           float(index.z * kBlockSide) * s);
+  const bool clearing = f.clear_depth_m > f.max_depth_m;
+  if (inside && clearing)
+    UpdateBlock<true, true>(f, index, block);
+  else if (inside)
+    UpdateBlock<true, false>(f, index, block);
+  else if (clearing)
+    UpdateBlock<false, true>(f, index, block);
   else
-    UpdateBlock<false>(f, index, block);
+    UpdateBlock<false, false>(f, index, block);
 }
 
 VOXPLAN_AVX2 int BandRowCandidatesSimd(const BandRow& r, BandCandidate* out, size_t* valid_count) {
