@@ -1,5 +1,6 @@
 // Free-space carving: blocks in front of the band are allocated and carved, the touched-block
-// list, the coverage of the subsampled carving rays, and scalar vs SIMD parity with carving on.
+// list, the coverage of the subsampled carving rays, clearing by readings beyond the range, and
+// scalar vs SIMD parity with carving on.
 #include <gtest/gtest.h>
 
 #include <cmath>
