@@ -97,9 +97,12 @@ const char* KernelName(Kernel kernel) {
 
 namespace {
 
-// Finite readings beyond max depth clear the free space in front of it.
-bool ClearsBeyond(const IntegrateParams& params) {
-  return params.carve_free_space && params.clear_beyond_max_depth;
+// The farthest reading that clears the free space in front of max depth (readings beyond max
+// depth up to it, so every finite one), or 0: none clears.
+float ClearDepth(const IntegrateParams& params) {
+  return params.carve_free_space && params.clear_beyond_max_depth
+             ? std::numeric_limits<float>::max()
+             : 0.f;
 }
 
 // Carving ray tiles: square, small enough that rays through neighbouring tile corners are at
@@ -229,8 +232,8 @@ std::vector<BlockIndex> CollectBlocks(const DepthImage& depth, const PinholeCame
     // it vectorises), then per tile over its columns.
     std::vector<float> tile_max(size_t(tiles_u) * size_t(tiles_v), 0.f);
     const float lo = params.min_depth_m, hi = params.max_depth_m;
-    // A reading beyond max depth that clears carves up to max depth (ClearsBeyond).
-    const float clear = ClearsBeyond(params) ? std::numeric_limits<float>::max() : 0.f;
+    // A reading beyond max depth that clears carves up to max depth.
+    const float clear = ClearDepth(params);
     ParallelFor(size_t(tiles_v), 1, [&](size_t begin, size_t end) {
       std::vector<float> column_max(size_t(depth.width));
       for (size_t tv = begin; tv < end; ++tv) {
@@ -401,7 +404,7 @@ Result<IntegrateStats> IntegrateFrame(const DepthImage& depth, const ColorImage&
   }
   f.min_depth_m = params.min_depth_m;
   f.max_depth_m = params.max_depth_m;
-  f.clear_depth_m = ClearsBeyond(params) ? std::numeric_limits<float>::max() : 0.f;
+  f.clear_depth_m = ClearDepth(params);
   f.trunc_m = volume.trunc_m();
   f.inv_trunc = 1.0f / volume.trunc_m();
   f.voxel_size_m = volume.voxel_size_m();
