@@ -345,6 +345,7 @@ std::vector<uint8_t> SettledCells::Mask(const omt::RasterGeometry& g) const {
 omt::PlannerOptions PassOptions(const CommonOptions& options, const WorldInput& input) {
   omt::PlannerOptions o = options.omt;
   o.robot_radius_m = input.robot_radius_m;
+  o.path_margin_m = options.clearance_margin_m;
   omt::SensorParams& s = o.views.sensor;
   // The host's angles and ranges are floats: a camera equal to the sensor is not narrower.
   constexpr double kRounding = 1e-5;

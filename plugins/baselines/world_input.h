@@ -44,8 +44,11 @@ class JsonOptions {
 struct CommonOptions {
   // kappa, importance_threshold, geodesic_cell_m, num_threads (and, for omt, the ablations).
   omt::PlannerOptions omt;
-  double robot_radius_m = 0.0;        // <= 0: the largest robot radius of the world
-  double clearance_margin_m = 0.0;    // added to the radius for the host's geodesic queries
+  double robot_radius_m = 0.0;  // <= 0: the largest robot radius of the world
+  // Added to the radius for the host's geodesic queries and omt's smoothed paths: the host's own
+  // routes keep as much (ExploreParams::route_margin_m), and a path that grazes a known wall on the
+  // offset grid of the true floor collides there.
+  double clearance_margin_m = 0.05;
   double dwell_s = 0.5;               // standing time at a view, so the sensor takes it in
   double surface_min_height_m = 0.1;  // surface voxels lower than this above the floor are floor
   // Geodesics of the omt pass: "host" (distance_matrix / shortest_path, the distances the host

@@ -319,6 +319,31 @@ Assignment AssignTasks(const AssignmentProblem& p, const AssignmentParams& param
   return out;
 }
 
+void HandOutUnassigned(const AssignmentProblem& problem, double unreachable_m, Assignment* a) {
+  std::vector<int> tasks_of(static_cast<std::size_t>(problem.num_robots), 0);
+  for (int r : a->task_robot)
+    if (r >= 0) ++tasks_of[static_cast<std::size_t>(r)];
+  for (int r = 0; r < problem.num_robots; ++r) {
+    if (tasks_of[static_cast<std::size_t>(r)] > 0) continue;
+    int best_cluster = -1;
+    double best_m = unreachable_m;  // unreachable tasks are not handed out
+    for (int k = 0; k < problem.num_tasks; ++k) {
+      if (a->task_robot[static_cast<std::size_t>(k)] >= 0) continue;
+      if (problem.robot_task(r, k) < best_m) {
+        best_m = problem.robot_task(r, k);
+        best_cluster = a->task_cluster[static_cast<std::size_t>(k)];
+      }
+    }
+    if (best_cluster < 0) continue;  // none it can reach
+    for (int k = 0; k < problem.num_tasks; ++k) {
+      if (a->task_cluster[static_cast<std::size_t>(k)] == best_cluster)
+        a->task_robot[static_cast<std::size_t>(k)] = r;
+    }
+    a->cluster_robot[static_cast<std::size_t>(best_cluster)] = r;
+    a->cost = Eq4Cost(problem, a->task_robot);
+  }
+}
+
 Assignment BruteForceAssignment(const AssignmentProblem& p, long max_labellings) {
   Assignment out;
   const int K = p.num_tasks;

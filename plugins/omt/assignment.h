@@ -40,6 +40,11 @@ struct Assignment {
   double cost = 0.0;  // eq. 4 over robot clusters
 };
 
+// Robots `a` leaves without a task (in index order) each take the unassigned cluster whose
+// nearest task is nearest to them, of those nearer than unreachable_m: a robot does not stand
+// still while work waits. Clusters stay whole (the refinement made them compact).
+void HandOutUnassigned(const AssignmentProblem& problem, double unreachable_m, Assignment* a);
+
 // Eq. 4 for a labelling (unassigned tasks, -1, do not enter), each ω_r the best medoid.
 double Eq4Cost(const AssignmentProblem& problem, const std::vector<int>& task_robot);
 

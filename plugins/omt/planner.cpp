@@ -143,8 +143,17 @@ Status PlanOmt(const OccupancyRaster& raster, const ClearanceRaster* clearance_i
                                             provider ? provider->anchored_robots : 0);
   result->views = std::move(view_set.views);
   result->anchored_robots = view_set.anchored_robots;
+  result->extracted_views = static_cast<int>(result->views.size());
   result->terminated = ShouldTerminate(result->views, options.importance_threshold);
   if (result->terminated) return Status::Ok();
+  // A view too poor to keep the run going (the termination test) is not worth a trip while a
+  // better one remains: assigned, it fills tours ahead of the views that matter, and
+  // re-planning keeps redrawing those tours.
+  if (!options.assign_unimportant_views) {
+    std::erase_if(result->views, [&](const TaskView& v) {
+      return !(v.importance > options.importance_threshold);
+    });
+  }
   const int K = static_cast<int>(result->views.size());
 
   // Geodesics between all robots and views (robots first): the provider's, or one Dijkstra
@@ -223,13 +232,14 @@ Status PlanOmt(const OccupancyRaster& raster, const ClearanceRaster* clearance_i
   AssignmentParams assignment_params = options.assignment;
   assignment_params.refine = options.refine;
   result->assignment = AssignTasks(problem, assignment_params);
+  if (options.hand_out_unassigned) HandOutUnassigned(problem, unreachable, &result->assignment);
 
   // Per robot: open TSP robot → farthest task, geodesic polyline, eq. 5, camera yaw.
   std::vector<double> task_yaw(static_cast<std::size_t>(K));
   for (int k = 0; k < K; ++k)
     task_yaw[static_cast<std::size_t>(k)] = result->views[static_cast<std::size_t>(k)].yaw_rad;
   SmoothingParams smoothing = options.smoothing;
-  smoothing.min_clearance_m = options.robot_radius_m;
+  smoothing.min_clearance_m = options.robot_radius_m + options.path_margin_m;
   std::vector<Status> statuses(static_cast<std::size_t>(R));
   // First each robot's polyline through its tasks, then the smoothing. Provider callbacks (the
   // host's) are only ever called from this thread, so with them the polylines are built one

@@ -25,19 +25,26 @@ struct PlannerOptions {
   int kappa = 6;  // κ: at most κR task views per pass
   double robot_radius_m = 0.18;
   double geodesic_cell_m = 0.2;  // node spacing of the internal geodesic grid
-  double snap_radius_m = 0.5;    // a robot off accessible cells starts from the nearest within this
+  // Smoothed paths keep robot_radius_m + path_margin_m from obstacles (the views keep theirs).
+  double path_margin_m = 0.0;
+  double snap_radius_m = 0.5;  // a robot off accessible cells starts from the nearest within this
   // §4 termination, for the paper's sensor (SensorParams' defaults); a caller whose views see
   // more or less scales it by ViewCapacity (plugins/baselines PassOptions).
   double importance_threshold = 1.5;
   TaskViewParams views;  // max_views and robot_radius_m are set from kappa and robot_radius_m
   AssignmentParams assignment;  // refine is set from the flag below
   TspParams tsp;
-  SmoothingParams smoothing;  // min_clearance_m is set to robot_radius_m
+  SmoothingParams smoothing;  // min_clearance_m is set to robot_radius_m + path_margin_m
   // Ablations of Table 1 (false reproduces NoTV, NoTSP, NoRefine, NoPO).
   bool use_task_views = true;
   bool use_tsp = true;
   bool refine = true;
   bool optimize_paths = true;
+  // Views at or below importance_threshold go into the assignment too (the earlier behaviour);
+  // by default they are dropped while a better one remains, as GRD and SEG drop them.
+  bool assign_unimportant_views = false;
+  // A robot the assignment leaves without a task takes the nearest cluster it left unassigned.
+  bool hand_out_unassigned = true;
   int num_threads =
       2;  // geodesics and per-robot paths run in parallel; results do not depend on it
 };
@@ -51,6 +58,7 @@ struct RobotPlan {
 
 struct PlanResult {
   std::vector<TaskView> views;  // accessible task views (the assignment's tasks)
+  int extracted_views = 0;      // views before those not above the threshold were dropped
   Assignment assignment;
   std::vector<RobotPlan> robots;  // one per input robot; empty plan = no task this pass
   bool terminated = false;        // no accessible view with importance above the threshold

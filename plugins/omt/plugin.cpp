@@ -27,6 +27,8 @@ class OmtPlanner : public vp::Planner {
     o.use_tsp = json.Flag("use_tsp", o.use_tsp);
     o.refine = json.Flag("refine", o.refine);
     o.optimize_paths = json.Flag("optimize_paths", o.optimize_paths);
+    o.assign_unimportant_views = json.Flag("assign_unimportant_views", o.assign_unimportant_views);
+    o.hand_out_unassigned = json.Flag("hand_out_unassigned", o.hand_out_unassigned);
     o.assignment.delta_m = json.Number("delta_m", o.assignment.delta_m, 0.0, 1e3);
     json.RejectUnknownKeys();
   }
@@ -94,7 +96,7 @@ class OmtPlanner : public vp::Planner {
       length_m += p.length_m;
       tasks += int(p.tasks.size());
     }
-    out.Diagnostic("views", double(result.views.size()));
+    out.Diagnostic("views", double(result.extracted_views));  // as the baselines count them
     out.Diagnostic("views_important", important);
     out.Diagnostic("max_importance", max_importance);
     out.Diagnostic("importance_threshold", threshold);

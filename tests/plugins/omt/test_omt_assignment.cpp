@@ -136,6 +136,30 @@ TEST(OmtAssignment, RefinementLeavesScatteredTasksUnassigned) {
   EXPECT_GE(plain.task_robot.back(), 0);
 }
 
+TEST(OmtAssignment, RobotsWithoutTasksTakeTheNearestUnassignedCluster) {
+  // Robot 0 holds its cluster; robots 1 and 2 hold nothing. Unassigned: a two-task cluster (3),
+  // a single task near robot 1 (4) and one no robot reaches (5).
+  const std::vector<Eigen::Vector2d> robots{{0.0, 0.0}, {10.0, 0.0}, {20.0, 0.0}};
+  const std::vector<Eigen::Vector2d> tasks{{0.0, 1.0},  {0.0, 1.2}, {12.0, 5.0},
+                                           {12.0, 5.3}, {9.0, 3.0}, {30.0, 0.0}};
+  AssignmentProblem p = EuclideanProblem(robots, tasks);
+  constexpr double kUnreachableM = 1e6;
+  for (int r = 0; r < 3; ++r) p.robot_task(r, 5) = kUnreachableM;
+  Assignment a;
+  a.task_robot = {0, 0, -1, -1, -1, -1};
+  a.task_cluster = {0, 0, 3, 3, 4, 5};
+  a.cluster_robot = {0, 1, 2, -1, -1, -1};
+  HandOutUnassigned(p, kUnreachableM, &a);
+  // Robot 1 takes the single task 3.2 m away (not the pair 5.4 m away); robot 2 the pair, whole.
+  EXPECT_EQ(a.task_robot, (std::vector<int>{0, 0, 2, 2, 1, -1}));
+  EXPECT_EQ(a.cluster_robot, (std::vector<int>{0, 1, 2, 2, 1, -1}));
+  EXPECT_NEAR(a.cost, Eq4Cost(p, a.task_robot), 1e-9);
+  // Nothing changes when every robot holds a task.
+  const Assignment before = a;
+  HandOutUnassigned(p, kUnreachableM, &a);
+  EXPECT_EQ(a.task_robot, before.task_robot);
+}
+
 TEST(OmtAssignment, RefinedClustersAreCompact) {
   std::mt19937 rng(7);
   std::uniform_real_distribution<double> coord(0.0, 8.0);

@@ -1,5 +1,6 @@
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <set>
 #include <thread>
 
@@ -61,6 +62,54 @@ TEST_F(OmtPlanner, FullPassAssignsEachViewOnceAlongCollisionFreePaths) {
     if (result.assignment.task_robot[k] >= 0) {
       EXPECT_TRUE(visited.count(static_cast<int>(k)));
     }
+}
+
+TEST_F(OmtPlanner, ViewsNotAboveTheThresholdAreLeftOutWhileABetterOneRemains) {
+  PlannerOptions all;
+  all.assign_unimportant_views = true;
+  PlanResult every;
+  ASSERT_TRUE(PlanOmt(raster_, &clearance_, Robots(), all, &every).ok());
+  std::vector<double> importance;
+  for (const TaskView& v : every.views) importance.push_back(v.importance);
+  std::sort(importance.begin(), importance.end());
+  ASSERT_GE(importance.size(), 4u);
+  // A threshold between two of the views' importances, so that some fall on each side.
+  const std::size_t mid = importance.size() / 2;
+  ASSERT_LT(importance[mid - 1], importance[mid]);
+  const double threshold = 0.5 * (importance[mid - 1] + importance[mid]);
+  PlannerOptions options;
+  options.importance_threshold = threshold;
+  PlanResult result;
+  ASSERT_TRUE(PlanOmt(raster_, &clearance_, Robots(), options, &result).ok());
+  EXPECT_FALSE(result.terminated);
+  EXPECT_EQ(result.views.size(), importance.size() - mid);
+  for (const TaskView& v : result.views) EXPECT_GT(v.importance, threshold);
+  all.importance_threshold = threshold;
+  ASSERT_TRUE(PlanOmt(raster_, &clearance_, Robots(), all, &result).ok());
+  EXPECT_EQ(result.views.size(), importance.size());
+}
+
+TEST_F(OmtPlanner, SmoothedPathsKeepTheMarginBeyondTheRadius) {
+  constexpr double kMarginM = 0.1;
+  PlannerOptions options;
+  for (double margin : {0.0, kMarginM}) {
+    options.path_margin_m = margin;
+    PlanResult result;
+    ASSERT_TRUE(PlanOmt(raster_, &clearance_, Robots(), options, &result).ok());
+    int clear = 0, planned = 0;
+    for (const RobotPlan& plan : result.robots) {
+      if (plan.path.empty()) continue;
+      ++planned;
+      clear += PathClear(clearance_, plan.path, options.robot_radius_m + kMarginM);
+    }
+    ASSERT_GT(planned, 0);
+    // Without the margin some path hugs a corner closer than that.
+    if (margin > 0.0) {
+      EXPECT_EQ(clear, planned);
+    } else {
+      EXPECT_LT(clear, planned);
+    }
+  }
 }
 
 TEST(OmtAccessibility, ADoorwayBarelyWiderThanTheRobotLeadsOn) {
