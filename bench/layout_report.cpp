@@ -18,8 +18,9 @@ int main() {
   std::printf("%-34s %8zu\n", "pool chunk (blocks)", size_t(BlockPool::kChunkBlocks));
   // The map keeps load factor <= 1/2: at most 2 hash slots per block, 24 bytes over 512 voxels.
   const double hash_per_voxel = 2.0 * (sizeof(uint64_t) + sizeof(uint32_t)) / kBlockVoxels;
-  std::printf("{\"block_bytes\":%zu,\"voxel_payload_bytes\":%.3f,\"hash_bytes_per_voxel_max\":%.4f,"
-              "\"bytes_per_voxel_max\":%.4f}\n",
-              sizeof(TsdfBlock), TsdfVolume::BytesPerVoxel(), hash_per_voxel,
-              TsdfVolume::BytesPerVoxel() + hash_per_voxel);
+  std::printf(
+      "{\"block_bytes\":%zu,\"voxel_payload_bytes\":%.3f,\"hash_bytes_per_voxel_max\":%.4f,"
+      "\"bytes_per_voxel_max\":%.4f}\n",
+      sizeof(TsdfBlock), TsdfVolume::BytesPerVoxel(), hash_per_voxel,
+      TsdfVolume::BytesPerVoxel() + hash_per_voxel);
 }

@@ -32,8 +32,8 @@ struct DatasetInfo {
   double depth_scale = 0.0;  // units per metre
   size_t num_frames = 0;
   bool has_color = false;
-  std::string intrinsics_source;  // the file they came from, "flag" or "default (...)"
-  std::string pose_source;        // the file poses came from, or "none"
+  std::string intrinsics_source;      // the file they came from, "flag" or "default (...)"
+  std::string pose_source;            // the file poses came from, or "none"
   std::vector<std::string> warnings;  // one line each, e.g. frames dropped for lack of poses
 };
 

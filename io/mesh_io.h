@@ -11,8 +11,8 @@ namespace voxplan {
 enum class UpAxis { kZ, kY };
 
 struct MeshReadOptions {
-  float scale = 1.0f;       // multiplies coordinates after the file's own unit scale
-  UpAxis up = UpAxis::kZ;   // kY rotates a Y-up file into voxplan's Z-up world
+  float scale = 1.0f;      // multiplies coordinates after the file's own unit scale
+  UpAxis up = UpAxis::kZ;  // kY rotates a Y-up file into voxplan's Z-up world
 };
 
 // All meshes of the file merged into one, node transforms applied; per-vertex colour from the

@@ -323,6 +323,7 @@ void HandOutUnassigned(const AssignmentProblem& problem, double unreachable_m, A
   std::vector<int> tasks_of(static_cast<std::size_t>(problem.num_robots), 0);
   for (int r : a->task_robot)
     if (r >= 0) ++tasks_of[static_cast<std::size_t>(r)];
+  bool changed = false;
   for (int r = 0; r < problem.num_robots; ++r) {
     if (tasks_of[static_cast<std::size_t>(r)] > 0) continue;
     int best_cluster = -1;
@@ -340,8 +341,9 @@ void HandOutUnassigned(const AssignmentProblem& problem, double unreachable_m, A
         a->task_robot[static_cast<std::size_t>(k)] = r;
     }
     a->cluster_robot[static_cast<std::size_t>(best_cluster)] = r;
-    a->cost = Eq4Cost(problem, a->task_robot);
+    changed = true;
   }
+  if (changed) a->cost = Eq4Cost(problem, a->task_robot);
 }
 
 Assignment BruteForceAssignment(const AssignmentProblem& p, long max_labellings) {

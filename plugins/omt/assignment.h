@@ -32,9 +32,11 @@ struct AssignmentParams {
 };
 
 struct Assignment {
-  std::vector<int> task_robot;     // robot per task, -1 when left unassigned (refinement)
-  std::vector<int> task_cluster;   // final cluster per task
-  std::vector<int> cluster_robot;  // robot seeding each cluster, -1 for task-seeded ones
+  std::vector<int> task_robot;    // robot per task, -1 when left unassigned (refinement)
+  std::vector<int> task_cluster;  // final cluster per task
+  // Robot each cluster goes to: its seed, or the robot HandOutUnassigned gave it to; -1 for
+  // task-seeded ones left unassigned.
+  std::vector<int> cluster_robot;
   int iterations = 0;
   bool converged = false;
   double cost = 0.0;  // eq. 4 over robot clusters
