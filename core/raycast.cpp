@@ -58,10 +58,6 @@ struct RangeImage {
   std::vector<float> surface_z_min;
 };
 
-struct Chunk {
-  std::vector<float> z_min, z_max, surface_z_min;
-};
-
 // Bricks of kBrickSide^3 voxels: the unit at which negative voxels (behind a surface) are
 // splatted into the surface range image. kBrickSide = 2 gives 64 bricks, one bit each.
 constexpr int kBrickSide = 2;
@@ -154,11 +150,78 @@ constexpr size_t kSurfaceRowPad = 3;
 #endif
 }
 
+// A visible block: its negative bricks are still to be splatted.
+struct VisibleBlock {
+  const TsdfBlock* block;
+  BlockIndex index;
+  Eigen::Vector3f p0_C;
+  float z_lo;       // the block's nearest depth, at least z_near
+  uint64_t bricks;  // NegativeBrickMask
+};
+
+// A part of the map's blocks, splatted into its own images (min and max are order-independent,
+// so the parts cannot change the result).
+struct Chunk {
+  std::vector<float> z_min, z_max, surface_z_min;
+  std::vector<VisibleBlock> visible;
+};
+
+// The negative-brick masks of the visible blocks by block index (open addressing), for the
+// neighbour tests of SplatBricks.
+class BrickMaskTable {
+ public:
+  void Build(const std::vector<Chunk>& chunks) {
+    size_t n = 0;
+    for (const Chunk& chunk : chunks) n += chunk.visible.size();
+    bits_ = std::max(int(std::bit_width(2 * n)), 4);
+    keys_.assign(size_t(1) << bits_, kEmpty);
+    masks_.resize(keys_.size());
+    for (const Chunk& chunk : chunks)
+      for (const VisibleBlock& v : chunk.visible) {
+        if (!v.bricks) continue;
+        const uint64_t key = PackBlockIndex(v.index);
+        size_t i = Slot(key);
+        while (keys_[i] != kEmpty) i = (i + 1) & (keys_.size() - 1);
+        keys_[i] = key;
+        masks_[i] = v.bricks;
+      }
+  }
+  // 0 for a block that is not visible or holds no negative voxel.
+  uint64_t Find(BlockIndex b) const {
+    if (!InPackRange(b)) return 0;
+    const uint64_t key = PackBlockIndex(b);
+    for (size_t i = Slot(key);; i = (i + 1) & (keys_.size() - 1)) {
+      if (keys_[i] == key) return masks_[i];
+      if (keys_[i] == kEmpty) return 0;
+    }
+  }
+
+ private:
+  static constexpr uint64_t kEmpty = ~uint64_t{0};  // no packed index has all bits set
+  size_t Slot(uint64_t key) const { return size_t((key * 0x9e3779b97f4a7c15ull) >> (64 - bits_)); }
+  int bits_ = 4;
+  std::vector<uint64_t> keys_, masks_;
+};
+
+// Interior bricks. Where a ray first meets the negative bricks, it enters one, B, through a
+// face that the camera sees, and the point lies on the brick beyond that face too. If that
+// brick is negative, its splat bounds the ray as well as B's; repeating the step moves towards
+// the camera, so it ends at a splatted brick. Hence a negative brick whose neighbours across
+// every face the camera sees are negative need not be splatted, provided it lies beyond z_near
+// (so that rays enter it from outside). Bricks of a block are bits bx + 4 by + 16 bz: along
+// axis a a brick is kBrickStride[a] bits on, and kFace0[a] holds those with coordinate 0.
+constexpr int kBrickStride[3] = {1, kBricksPerSide, kBricks / kBricksPerSide};
+constexpr uint64_t kFace0[3] = {0x1111111111111111ull, 0x000f000f000f000full, 0xffffull};
+// Bricks within this fraction of a brick of the camera's plane along an axis count as seen
+// from both sides (more neighbours asked for, never fewer).
+constexpr float kSideMargin = 0.01f;
+
 // What splatting blocks into a range image needs for one cast: the camera, the pose and the
 // block and brick geometry in the camera frame.
 struct Splatter {
   const PinholeCamera& camera;
   Pose3f T_C_W;
+  Eigen::Vector3f camera_W;
   float block_m, z_near, z_far;
   int cols, surface_cols;
   size_t num_cells, num_surface_cells;
@@ -168,22 +231,15 @@ struct Splatter {
   Eigen::Vector3f voxel_x, voxel_y, voxel_z, block_half_extent, brick_half_extent,
       to_block_centre_C, to_brick_centre_C;
 
-  // A visible block whose negative bricks are still to be splatted.
-  struct Visible {
-    const TsdfBlock* block;
-    Eigen::Vector3f p0_C;
-    float z_lo;  // the block's nearest depth, at least z_near
-  };
-
-  // Splats blocks [first, last) into `chunk`; `visible` is scratch space.
-  [[gnu::always_inline]] inline void Run(const BlockIndex* blocks, const TsdfBlock* const* data,
-                                         size_t first, size_t last, Chunk& chunk,
-                                         std::vector<Visible>& visible) const {
+  // Splats blocks [first, last) into the chunk's block-range images and lists the visible ones
+  // with their negative bricks.
+  [[gnu::always_inline]] inline void CullBlocks(const BlockIndex* blocks,
+                                                const TsdfBlock* const* data, size_t first,
+                                                size_t last, Chunk& chunk) const {
     constexpr float kInf = std::numeric_limits<float>::infinity();
     chunk.z_min.assign(num_cells, kInf);
     chunk.z_max.assign(num_cells, -kInf);
-    // Padded so that a row of cells is updated four at a time (see below).
-    chunk.surface_z_min.assign(num_surface_cells + kSurfaceRowPad, kInf);
+    std::vector<VisibleBlock>& visible = chunk.visible;
     visible.clear();
     for (size_t k = first; k < last; ++k) {
       const Eigen::Vector3f p0_C = T_C_W * BlockOrigin(blocks[k], block_m);
@@ -199,10 +255,10 @@ struct Splatter {
           chunk.z_min[cell] = std::min(chunk.z_min[cell], z_lo);
           chunk.z_max[cell] = std::max(chunk.z_max[cell], z_hi);
         }
-      visible.push_back({data[k], p0_C, z_lo});
+      visible.push_back({data[k], blocks[k], p0_C, z_lo, 0});
     }
-    // The visible blocks' negative bricks. Blocks lie scattered over the pool, so each would
-    // wait on its distances line by line: those of a block a few places ahead are prefetched.
+    // Blocks lie scattered over the pool, so each would wait on its distances line by line:
+    // those of a block a few places ahead are prefetched.
     constexpr size_t kAhead = 4;
     for (size_t j = 0; j < visible.size(); ++j) {
       if (j + kAhead < visible.size()) {
@@ -211,13 +267,61 @@ struct Splatter {
         for (size_t line = 0; line < sizeof(TsdfBlock::tsdf); line += kCacheLine)
           __builtin_prefetch(tsdf + line);
       }
-      const auto& [block, p0_C, z_lo] = visible[j];
-      uint64_t bricks = NegativeBrickMask(*block);
-      // Each brick holding a negative voxel splats the near depth of its cube's camera-aligned
-      // bounding box (a lower bound of those voxels' cubes) over the pixels the box can
-      // project to (the whole block's where the box reaches z_near).
-      const Eigen::Vector3f brick0_C = p0_C + to_brick_centre_C;
-      for (; bricks; bricks &= bricks - 1) {
+      visible[j].bricks = NegativeBrickMask(*visible[j].block);
+    }
+  }
+
+  // The bricks of `v` that need not be splatted (see kBrickStride): negative, with negative
+  // neighbours across every face the camera sees.
+  uint64_t InteriorBricks(const VisibleBlock& v, const BrickMaskTable& table) const {
+    const uint64_t negative = v.bricks;
+    // The camera in the block's brick units.
+    const Eigen::Vector3f t =
+        (camera_W - BlockOrigin(v.index, block_m)) * (float(kBricksPerSide) / block_m);
+    uint64_t interior = negative;
+    for (int a = 0; a < 3 && interior; ++a) {
+      const int stride = kBrickStride[a];
+      const uint64_t face0 = kFace0[a], face_last = face0 << ((kBricksPerSide - 1) * stride);
+      // Bricks whose face towards -a (+a) the camera sees.
+      uint64_t sees_minus = 0, sees_plus = 0;
+      for (int k = 0; k < kBricksPerSide; ++k) {
+        if (t[a] < float(k) + kSideMargin) sees_minus |= face0 << (k * stride);
+        if (t[a] > float(k + 1) - kSideMargin) sees_plus |= face0 << (k * stride);
+      }
+      // Per brick, whether its neighbour towards -a (+a) is negative: in the block, or the
+      // facing brick of the next block, looked up only when a candidate needs it.
+      BlockIndex next = v.index;
+      uint64_t minus = (negative << stride) & ~face0;
+      if (interior & sees_minus & face0) {
+        (&next.x)[a] -= 1;
+        minus |= (table.Find(next) & face_last) >> ((kBricksPerSide - 1) * stride);
+        (&next.x)[a] += 1;
+      }
+      interior &= ~sees_minus | minus;
+      uint64_t plus = (negative >> stride) & ~face_last;
+      if (interior & sees_plus & face_last) {
+        (&next.x)[a] += 1;
+        plus |= (table.Find(next) & face0) << ((kBricksPerSide - 1) * stride);
+      }
+      interior &= ~sees_plus | plus;
+    }
+    return interior;
+  }
+
+  // Splats the negative bricks of the chunk's visible blocks into its surface image, but for
+  // interior ones.
+  [[gnu::always_inline]] inline void SplatBricks(const BrickMaskTable& table, Chunk& chunk) const {
+    constexpr float kInf = std::numeric_limits<float>::infinity();
+    // Padded so that a row of cells is updated four at a time (see MinRow).
+    chunk.surface_z_min.assign(num_surface_cells + kSurfaceRowPad, kInf);
+    for (const VisibleBlock& v : chunk.visible) {
+      if (!v.bricks) continue;
+      const uint64_t interior = InteriorBricks(v, table);
+      // Each other brick splats the near depth of its cube's camera-aligned bounding box (a
+      // lower bound of its voxels' cubes) over the pixels the box can project to (the whole
+      // block's where the box reaches z_near).
+      const Eigen::Vector3f brick0_C = v.p0_C + to_brick_centre_C;
+      for (uint64_t bricks = v.bricks; bricks; bricks &= bricks - 1) {
         const int i = std::countr_zero(bricks);
         const int bx = i % kBricksPerSide, by = (i / kBricksPerSide) % kBricksPerSide,
                   bz = i / (kBricksPerSide * kBricksPerSide);
@@ -225,7 +329,9 @@ struct Splatter {
             brick0_C +
             float(kBrickSide) * (float(bx) * voxel_x + float(by) * voxel_y + float(bz) * voxel_z);
         const float z_front = c_C.z() - brick_half_extent.z();
-        const float surface_z = std::max(z_front, z_lo);
+        // Interior bricks clearly beyond z_near: rays reach them through a splatted one.
+        if ((interior >> i) & 1 && z_front > z_near + brick_half_extent.z()) continue;
+        const float surface_z = std::max(z_front, v.z_lo);
         PixelRange pixels;
         if (!ProjectBox(camera, c_C, brick_half_extent, z_near, &pixels)) continue;
         const int cx_lo = int(pixels.u_lo) / kSurfaceCell, cx_hi = int(pixels.u_hi) / kSurfaceCell;
@@ -237,18 +343,25 @@ struct Splatter {
   }
 };
 
-void SplatChunk(const Splatter& splatter, const BlockIndex* blocks, const TsdfBlock* const* data,
-                size_t first, size_t last, Chunk& chunk, std::vector<Splatter::Visible>& visible) {
-  splatter.Run(blocks, data, first, last, chunk, visible);
+void CullChunk(const Splatter& splatter, const BlockIndex* blocks, const TsdfBlock* const* data,
+               size_t first, size_t last, Chunk& chunk) {
+  splatter.CullBlocks(blocks, data, first, last, chunk);
+}
+void SplatChunk(const Splatter& splatter, const BrickMaskTable& table, Chunk& chunk) {
+  splatter.SplatBricks(table, chunk);
 }
 
 #if VOXPLAN_RAYCAST_AVX2
 // The same code for AVX2 CPUs, where std::ceil and std::floor are one instruction (SSE4.1's
 // round) instead of a dozen; the results are the same.
-VOXPLAN_TARGET_AVX2 void SplatChunkAvx2(const Splatter& splatter, const BlockIndex* blocks,
-                                        const TsdfBlock* const* data, size_t first, size_t last,
-                                        Chunk& chunk, std::vector<Splatter::Visible>& visible) {
-  splatter.Run(blocks, data, first, last, chunk, visible);
+VOXPLAN_TARGET_AVX2 void CullChunkAvx2(const Splatter& splatter, const BlockIndex* blocks,
+                                       const TsdfBlock* const* data, size_t first, size_t last,
+                                       Chunk& chunk) {
+  splatter.CullBlocks(blocks, data, first, last, chunk);
+}
+VOXPLAN_TARGET_AVX2 void SplatChunkAvx2(const Splatter& splatter, const BrickMaskTable& table,
+                                        Chunk& chunk) {
+  splatter.SplatBricks(table, chunk);
 }
 #endif
 
@@ -261,7 +374,6 @@ RangeImage BuildRangeImage(const TsdfVolume& volume, const PinholeCamera& camera
   range.surface_rows = (camera.height + kSurfaceCell - 1) / kSurfaceCell;
   const size_t num_cells = size_t(range.cols) * size_t(range.rows);
   const size_t num_surface_cells = size_t(range.surface_cols) * size_t(range.surface_rows);
-  constexpr float kInf = std::numeric_limits<float>::infinity();
 
   std::vector<BlockIndex> blocks;
   std::vector<const TsdfBlock*> block_data;
@@ -271,10 +383,10 @@ RangeImage BuildRangeImage(const TsdfVolume& volume, const PinholeCamera& camera
     blocks.push_back(b);
     block_data.push_back(&data);
   });
-  // Min and max are order-independent, so the chunking (and the thread count) cannot change
-  // the result; each chunk owns its partial image, so nothing is shared while splatting.
+  // A chunk per thread at most: each holds whole images, set and merged serially.
   constexpr size_t kBlocksPerChunk = 1024;
-  const size_t num_chunks = std::clamp<size_t>(blocks.size() / kBlocksPerChunk, 1, 16);
+  const size_t num_chunks =
+      std::clamp<size_t>(blocks.size() / kBlocksPerChunk, 1, size_t(std::max(MaxThreads(), 1)));
   std::vector<Chunk> chunks(num_chunks);
   const float voxel_m = volume.voxel_size_m();
   const Eigen::Matrix3f R_C_W = T_C_W.linear();
@@ -285,6 +397,7 @@ RangeImage BuildRangeImage(const TsdfVolume& volume, const PinholeCamera& camera
   const Splatter splatter{
       camera,
       T_C_W,
+      T_C_W.inverse().translation(),
       block_m,
       MarchStart(volume, params),
       params.max_depth_m,
@@ -303,24 +416,37 @@ RangeImage BuildRangeImage(const TsdfVolume& volume, const PinholeCamera& camera
   const bool avx2 = params.simd && RaycastSimdAvailable();
 #endif
   ParallelFor(num_chunks, 1, [&](size_t begin, size_t end) {
-    std::vector<Splatter::Visible> visible;
     for (size_t c = begin; c < end; ++c) {
       const size_t first = blocks.size() * c / num_chunks;
       const size_t last = blocks.size() * (c + 1) / num_chunks;
 #if VOXPLAN_RAYCAST_AVX2
       if (avx2) {
-        SplatChunkAvx2(splatter, blocks.data(), block_data.data(), first, last, chunks[c], visible);
+        CullChunkAvx2(splatter, blocks.data(), block_data.data(), first, last, chunks[c]);
         continue;
       }
 #endif
-      SplatChunk(splatter, blocks.data(), block_data.data(), first, last, chunks[c], visible);
+      CullChunk(splatter, blocks.data(), block_data.data(), first, last, chunks[c]);
+    }
+  });
+  BrickMaskTable table;
+  table.Build(chunks);
+  ParallelFor(num_chunks, 1, [&](size_t begin, size_t end) {
+    for (size_t c = begin; c < end; ++c) {
+#if VOXPLAN_RAYCAST_AVX2
+      if (avx2) {
+        SplatChunkAvx2(splatter, table, chunks[c]);
+        continue;
+      }
+#endif
+      SplatChunk(splatter, table, chunks[c]);
     }
   });
 
-  range.z_min.assign(num_cells, kInf);
-  range.z_max.assign(num_cells, -kInf);
-  range.surface_z_min.assign(num_surface_cells, kInf);
-  for (const Chunk& chunk : chunks) {
+  range.z_min = std::move(chunks[0].z_min);
+  range.z_max = std::move(chunks[0].z_max);
+  range.surface_z_min = std::move(chunks[0].surface_z_min);
+  for (size_t c = 1; c < num_chunks; ++c) {
+    const Chunk& chunk = chunks[c];
     for (size_t i = 0; i < num_cells; ++i) {
       range.z_min[i] = std::min(range.z_min[i], chunk.z_min[i]);
       range.z_max[i] = std::max(range.z_max[i], chunk.z_max[i]);
@@ -836,7 +962,9 @@ class RayCaster {
     } lanes;
     std::memset(&lanes, 0, sizeof(lanes));
     for (auto& block : lanes.block) block = &kNoBlock;
-    // Starts lane l's march of the ray through `pixel` from z_begin to z_end.
+    for (auto& x : lanes.block_index[0]) x = kMaxBlockCoord + 1;  // out of range: no block
+    // Starts lane l's march of the ray through `pixel` from z_begin to z_end. The lane keeps
+    // its last block (index and pointer): the next ray, a nearby pixel's, often starts in it.
     auto start = [&](int l, const Eigen::Vector3f& dir_W, float z_begin, float z_end,
                      float z_skipped, size_t pixel) {
       Ray ray;
@@ -847,10 +975,8 @@ class RayCaster {
       for (int a = 0; a < 3; ++a) {
         lanes.dir_vox[a][l] = dir_vox[a];
         lanes.dir_W[a][l] = dir_W[a];
-        lanes.block_index[a][l] = (&ray.block_index.x)[a];
       }
-      lanes.live[l] = -1, lanes.has_block[l] = 0, lanes.have_prev[l] = 0, lanes.met[l] = 0;
-      lanes.block[l] = &kNoBlock;
+      lanes.live[l] = -1, lanes.have_prev[l] = 0, lanes.met[l] = 0;
       lanes.pixel[l] = pixel;
       lanes.z_skipped[l] = z_skipped, lanes.z_begin[l] = z_begin;
     };
@@ -879,7 +1005,6 @@ class RayCaster {
         return true;
       }
       lanes.live[l] = 0;
-      lanes.block[l] = &kNoBlock;
       return false;
     };
     auto refine = [&] {
@@ -943,7 +1068,9 @@ class RayCaster {
           changed = _mm256_or_si256(
               changed, avx2::AndNot(_mm256_cmpeq_epi32(b, avx2::Load(lanes.block_index[a] + base)),
                                     minus_one));
-          avx2::Store(lanes.block_index[a] + base, b);  // lanes out of range never read it again
+          // Lanes out of range keep theirs, which stays their block's index for the next ray.
+          avx2::Store(lanes.block_index[a] + base,
+                      _mm256_blendv_epi8(avx2::Load(lanes.block_index[a] + base), b, in_range));
         }
         changed = _mm256_and_si256(changed, in_range);
         for (int bits = _mm256_movemask_ps(_mm256_castsi256_ps(changed)); bits; bits &= bits - 1) {
