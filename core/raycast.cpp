@@ -760,6 +760,11 @@ VOXPLAN_TARGET_AVX2 inline __m256i Floor(__m256 p) {
   return _mm256_add_epi32(
       truncated, _mm256_castps_si256(_mm256_cmp_ps(p, _mm256_cvtepi32_ps(truncated), _CMP_LT_OQ)));
 }
+// The zero of the line through (z_a, f_a) and (z_b, f_b), as Refine and Bracket compute it.
+VOXPLAN_TARGET_AVX2 inline __m256 Secant(__m256 z_a, __m256 z_b, __m256 f_a, __m256 f_b) {
+  return _mm256_add_ps(
+      z_a, _mm256_div_ps(_mm256_mul_ps(_mm256_sub_ps(z_b, z_a), f_a), _mm256_sub_ps(f_a, f_b)));
+}
 // The linear index inside its block of each lane's voxel g.
 VOXPLAN_TARGET_AVX2 inline __m256i LinearIndex(const __m256i g[3]) {
   const __m256i mask = _mm256_set1_epi32(kBlockMask);
@@ -1007,17 +1012,36 @@ class RayCaster {
       lanes.live[l] = 0;
       return false;
     };
+    // Results of a batch: written, or resumed where the crossing had no zero; lanes in `skip`
+    // are not done yet.
+    auto handle = [&](const Crossings& batch, unsigned found, const RayResult* results,
+                      unsigned skip) {
+      for (int j = 0; j < batch.count; ++j) {
+        if ((skip >> j) & 1) continue;
+        const Eigen::Vector3f dir_W(batch.dir_W[0][j], batch.dir_W[1][j], batch.dir_W[2][j]);
+        if ((found >> j) & 1)
+          write(batch.pixel[j], results[j], dir_W);
+        else
+          resumes.push_back(
+              {dir_W, batch.z_b[j], batch.z_end[j], int16_t(batch.tsdf_b[j]), batch.pixel[j]});
+      }
+    };
+    // Crossings whose Newton steps left their path wait in `brackets` for the bracket, which
+    // is refined kPacket at a time too.
+    Crossings brackets;
+    auto refine_brackets = [&] {
+      RayResult results[kPacket];
+      handle(brackets, BracketCrossings(brackets, results), results, 0);
+      brackets.count = 0;
+    };
     auto refine = [&] {
       RayResult results[kPacket];
-      const unsigned found = RefineCrossings(crossings, results);
-      for (int j = 0; j < crossings.count; ++j) {
-        const Eigen::Vector3f dir_W(crossings.dir_W[0][j], crossings.dir_W[1][j],
-                                    crossings.dir_W[2][j]);
-        if ((found >> j) & 1)
-          write(crossings.pixel[j], results[j], dir_W);
-        else
-          resumes.push_back({dir_W, crossings.z_b[j], crossings.z_end[j],
-                             int16_t(crossings.tsdf_b[j]), crossings.pixel[j]});
+      unsigned deferred = 0;
+      const unsigned found = RefineCrossings(crossings, results, &deferred);
+      handle(crossings, found, results, deferred);
+      for (; deferred; deferred &= deferred - 1) {
+        brackets.Append(crossings, std::countr_zero(deferred));
+        if (brackets.count == kPacket) refine_brackets();
       }
       crossings.count = 0;
     };
@@ -1046,9 +1070,10 @@ class RayCaster {
         _mm256_set1_epi32(int32_t(sampler_.min_weight_fixed()) - 1);
     const __m256i stop_at_back_faces = params_.stop_at_back_faces ? minus_one : zero;
 
-    while (num_live > 0 || crossings.count > 0 || !resumes.empty()) {
+    while (num_live > 0 || crossings.count > 0 || brackets.count > 0 || !resumes.empty()) {
       if (num_live == 0) {  // the last crossings, then the rays they resume
         if (crossings.count > 0) refine();
+        if (brackets.count > 0) refine_brackets();
         for (int l = 0; l < kPacketLanes; ++l) num_live += start_next(l);
         continue;
       }
@@ -1298,6 +1323,20 @@ class RayCaster {
     const TsdfBlock* block[kPacket];
     size_t pixel[kPacket];
     int count = 0;
+
+    // Appends crossing j of `other`.
+    void Append(const Crossings& other, int j) {
+      const int i = count++;
+      for (int a = 0; a < 3; ++a) {
+        dir_W[a][i] = other.dir_W[a][j];
+        block_index[a][i] = other.block_index[a][j];
+      }
+      z_a[i] = other.z_a[j], z_b[i] = other.z_b[j], voxel_z[i] = other.voxel_z[j];
+      z_end[i] = other.z_end[j];
+      tsdf_a[i] = other.tsdf_a[j], tsdf_b[i] = other.tsdf_b[j];
+      block[i] = other.block[j];
+      pixel[i] = other.pixel[j];
+    }
   };
   // A ray whose crossing had no zero, to march on from it.
   struct Resume {
@@ -1307,138 +1346,167 @@ class RayCaster {
     size_t pixel;
   };
 
-  // Cross for each of the crossings, as if called one by one: bit j of the result set when
-  // crossing j has its result in results[j], clear when the interpolant has no zero there.
-  // Refine's usual path (two Newton steps on complete cells, then normal and colour) runs in
-  // AVX2 lanes with the scalar code's float operations in its order, so the results are the
-  // same bytes; a lane that leaves that path (an unobserved corner, a grazing slope, a step out
-  // of bounds) is refined by Cross itself.
-  VOXPLAN_TARGET_AVX2 unsigned RefineCrossings(const Crossings& c, RayResult results[kPacket]) {
+  // The cells a packet of crossings last sampled, lane by lane: corner 0, its block (first the
+  // block the march last sampled), the corners of a cell across block faces; the corners'
+  // distances and weights are in rows_, as x-pairs (corner 2p in the low 16 bits of pair p,
+  // corner 2p + 1 in the high ones), loaded lane by lane into rows that AVX2 then reads.
+  struct PacketCells {
+    alignas(32) int32_t base[3][kPacket] = {}, i0[kPacket] = {}, block_index[3][kPacket];
+    alignas(32) const TsdfBlock* block[kPacket];
+    const TsdfBlock* across_block[kPacket][8];
+    int across_index[kPacket][8];
+    unsigned one_block = 0;  // bit l: lane l's cell lies in block[l]
+    unsigned loaded = 0;     // bit l: lane l's rows hold its cell (else an earlier batch's)
+  };
+
+  // Sample (Sampler::Gather, then ValueAndGradientSse2 lane by lane) at depth z on the rays of
+  // the active lanes; the other lanes' cells stay. The value, the position in the cell and the
+  // gradient are those of the active lanes; returns the lanes whose eight corners are observed.
+  VOXPLAN_TARGET_AVX2 __m256i SampleCells(PacketCells& cells, const __m256 dir[3], __m256 z,
+                                          __m256i active, __m256* value, __m256 frac[3],
+                                          __m256 gradient[3]) {
     using namespace avx2;
     const __m256i zero = _mm256_setzero_si256(), minus_one = _mm256_set1_epi32(-1);
+    __m256i g[3], changed = zero, moved = zero, inside_block = minus_one;
+    for (int a = 0; a < 3; ++a) {
+      const __m256 p = _mm256_add_ps(Set(origin_W_[a]), _mm256_mul_ps(z, dir[a]));
+      const __m256 q = _mm256_sub_ps(_mm256_mul_ps(p, Set(sampler_.inv_voxel())), Set(0.5f));
+      g[a] = Floor(q);
+      frac[a] = _mm256_sub_ps(q, _mm256_cvtepi32_ps(g[a]));
+      moved =
+          _mm256_or_si256(moved, AndNot(_mm256_cmpeq_epi32(g[a], Load(cells.base[a])), minus_one));
+      Store(cells.base[a], _mm256_blendv_epi8(Load(cells.base[a]), g[a], active));
+      const __m256i b = _mm256_srai_epi32(g[a], kBlockShift);
+      changed = _mm256_or_si256(
+          changed, AndNot(_mm256_cmpeq_epi32(b, Load(cells.block_index[a])), minus_one));
+      Store(cells.block_index[a], _mm256_blendv_epi8(Load(cells.block_index[a]), b, active));
+      // All eight corners in the block: corner 0 below its last voxel on every axis.
+      inside_block = _mm256_and_si256(
+          inside_block, _mm256_cmpgt_epi32(_mm256_set1_epi32(kBlockMask),
+                                           _mm256_and_si256(g[a], _mm256_set1_epi32(kBlockMask))));
+    }
+    Store(cells.i0, _mm256_blendv_epi8(Load(cells.i0), LinearIndex(g), active));
+    changed = _mm256_and_si256(changed, active);
+    for (int bits = _mm256_movemask_ps(_mm256_castsi256_ps(changed)); bits; bits &= bits - 1) {
+      const int l = std::countr_zero(unsigned(bits));
+      const TsdfBlock* found = sampler_.FindUncached(
+          BlockIndex{cells.block_index[0][l], cells.block_index[1][l], cells.block_index[2][l]});
+      cells.block[l] = found ? found : &kNoBlock;
+    }
+    // The corners of the lanes whose cell moved (LoadCorners, LoadCornersAcross).
+    auto& tsdf_pairs = rows_.tsdf_pairs;
+    auto& weight_pairs = rows_.weight_pairs;
+    const unsigned active_bits = unsigned(_mm256_movemask_ps(_mm256_castsi256_ps(active)));
+    const unsigned inside_bits = unsigned(_mm256_movemask_ps(_mm256_castsi256_ps(inside_block)));
+    unsigned load =
+        (unsigned(_mm256_movemask_ps(_mm256_castsi256_ps(moved))) | ~cells.loaded) & active_bits;
+    cells.loaded |= active_bits;
+    for (; load; load &= load - 1) {
+      const int l = std::countr_zero(load);
+      if ((inside_bits >> l) & 1) {
+        cells.one_block |= 1u << l;
+        const int16_t* tsdf = cells.block[l]->tsdf + cells.i0[l];
+        const uint16_t* weight = cells.block[l]->weight + cells.i0[l];
+        for (int p = 0; p < 4; ++p) {
+          std::memcpy(&tsdf_pairs[p][l], tsdf + kCornerOffset[2 * p], sizeof(uint32_t));
+          std::memcpy(&weight_pairs[p][l], weight + kCornerOffset[2 * p], sizeof(uint32_t));
+        }
+        continue;
+      }
+      cells.one_block &= ~(1u << l);
+      const TsdfBlock** blocks = cells.across_block[l];
+      const int* index = cells.across_index[l];
+      sampler_.CornersAcross(GlobalVoxelIndex{cells.base[0][l], cells.base[1][l], cells.base[2][l]},
+                             blocks, cells.across_index[l]);
+      for (int p = 0; p < 4; ++p) {
+        const int lo = 2 * p, hi = 2 * p + 1;
+        tsdf_pairs[p][l] = uint32_t(uint16_t(blocks[lo]->tsdf[index[lo]])) |
+                           uint32_t(uint16_t(blocks[hi]->tsdf[index[hi]])) << 16;
+        weight_pairs[p][l] =
+            uint32_t(blocks[lo]->weight[index[lo]]) | uint32_t(blocks[hi]->weight[index[hi]]) << 16;
+      }
+    }
+    // Decoded as LoadCorners does.
+    const __m256i min_weight_minus_one =
+        _mm256_set1_epi32(int32_t(sampler_.min_weight_fixed()) - 1);
+    __m256 t[8];
+    __m256i complete = minus_one;
+    const __m256i low16 = _mm256_set1_epi32(0xffff);
+    for (int p = 0; p < 4; ++p) {
+      const __m256i tsdf = Load(tsdf_pairs[p]), weight = Load(weight_pairs[p]);
+      t[2 * p] = Decode(_mm256_srai_epi32(_mm256_slli_epi32(tsdf, 16), 16));
+      t[2 * p + 1] = Decode(_mm256_srai_epi32(tsdf, 16));
+      complete = _mm256_and_si256(
+          complete, _mm256_and_si256(
+                        _mm256_cmpgt_epi32(_mm256_and_si256(weight, low16), min_weight_minus_one),
+                        _mm256_cmpgt_epi32(_mm256_srli_epi32(weight, 16), min_weight_minus_one)));
+    }
+    // ValueAndGradientSse2, lane by lane: edge j of four per axis, then the four summed in
+    // pairs.
+    const __m256 fx = frac[0], fy = frac[1], fz = frac[2];
+    __m256 v[4], gx[4], gy[4], gz[4];
+    for (int j = 0; j < 4; ++j) {
+      const bool odd = j & 1, high = j >= 2;
+      const __m256 wx = Lerp(odd, fx), wy = Lerp(high, fy), wz = Lerp(high, fz);
+      const __m256 wy_edge = Lerp(odd, fy);
+      const __m256 d_z = _mm256_sub_ps(t[j + 4], t[j]);
+      static constexpr int kX[4][2] = {{1, 0}, {3, 2}, {5, 4}, {7, 6}};
+      static constexpr int kY[4][2] = {{2, 0}, {3, 1}, {6, 4}, {7, 5}};
+      const __m256 d_x = _mm256_sub_ps(t[kX[j][0]], t[kX[j][1]]);
+      const __m256 d_y = _mm256_sub_ps(t[kY[j][0]], t[kY[j][1]]);
+      const __m256 wxy = _mm256_mul_ps(wx, wy);
+      v[j] = _mm256_mul_ps(wxy, _mm256_add_ps(t[j], _mm256_mul_ps(fz, d_z)));
+      gx[j] = _mm256_mul_ps(_mm256_mul_ps(wy_edge, wz), d_x);
+      gy[j] = _mm256_mul_ps(_mm256_mul_ps(wx, wz), d_y);
+      gz[j] = _mm256_mul_ps(wxy, d_z);
+    }
+    *value = Sum4(v);
+    gradient[0] = Sum4(gx), gradient[1] = Sum4(gy), gradient[2] = Sum4(gz);
+    return complete;
+  }
+
+  // SampleCells for the bracket: a lane whose cell has an unobserved corner leaves `live` for
+  // `scalar` (Cross then refines it itself).
+  VOXPLAN_TARGET_AVX2 __m256 SampleLive(PacketCells& cells, const __m256 dir[3], __m256 z,
+                                        __m256i* live, __m256i* scalar, __m256 frac[3],
+                                        __m256 gradient[3]) {
+    __m256 value;
+    const __m256i complete = SampleCells(cells, dir, z, *live, &value, frac, gradient);
+    *scalar = _mm256_or_si256(*scalar, avx2::AndNot(complete, *live));
+    *live = _mm256_and_si256(*live, complete);
+    return value;
+  }
+
+  // Cross for each of the crossings, as if called one by one: bit j of the result set when
+  // crossing j has its result in results[j], clear when the interpolant has no zero there.
+  // Refine runs in AVX2 lanes with the scalar code's float operations in its order, so the
+  // results are the same bytes: two Newton steps on complete cells, then normal and colour. The
+  // lanes that leave that path (a grazing slope, a step out of bounds, an unobserved corner)
+  // are set in `deferred`, for BracketCrossings.
+  VOXPLAN_TARGET_AVX2 unsigned RefineCrossings(const Crossings& c, RayResult results[kPacket],
+                                               unsigned* deferred) {
+    using namespace avx2;
+    const __m256i zero = _mm256_setzero_si256();
     const __m256 dir[3] = {LoadF(c.dir_W[0]), LoadF(c.dir_W[1]), LoadF(c.dir_W[2])};
     const __m256 z_a = LoadF(c.z_a), z_b = LoadF(c.z_b), voxel_z = LoadF(c.voxel_z);
     const __m256 nearest_a = Decode(Load(c.tsdf_a)), nearest_b = Decode(Load(c.tsdf_b));
     const __m256 max_slope = Set(MaxSlope());
     const __m256 dq_dz = Set(sampler_.inv_voxel());
-    const __m256i min_weight_minus_one =
-        _mm256_set1_epi32(int32_t(sampler_.min_weight_fixed()) - 1);
-    // Lanes on the usual path (`ok`) and those done with their Newton steps.
-    __m256i ok =
+    const __m256i valid =
         _mm256_cmpgt_epi32(_mm256_set1_epi32(c.count), _mm256_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7));
-    __m256i converged = zero;
-    __m256 z = _mm256_add_ps(z_a, _mm256_div_ps(_mm256_mul_ps(_mm256_sub_ps(z_b, z_a), nearest_a),
-                                                _mm256_sub_ps(nearest_a, nearest_b)));
-    // Per lane, the last sampled cell: corner 0, its block (first the block the march last
-    // sampled), the corners of a cell across block faces, the position and gradient, and the
-    // corners' distances and weights as x-pairs (corner 2p in the low 16 bits of pair p, corner
-    // 2p + 1 in the high ones), loaded lane by lane into rows that AVX2 then reads.
-    alignas(32) int32_t cell_base[3][kPacket] = {}, cell_i0[kPacket] = {}, block_index[3][kPacket];
-    alignas(32) const TsdfBlock* block[kPacket];
-    const TsdfBlock* across_block[kPacket][8];
-    int across_index[kPacket][8];
-    auto& tsdf_pairs = rows_.tsdf_pairs;
-    auto& weight_pairs = rows_.weight_pairs;
-    unsigned one_block = 0;  // bit l: lane l's cell lies in block[l]
-    std::memcpy(block_index, c.block_index, sizeof(block_index));
-    std::memcpy(block, c.block, sizeof(block));
+    // Lanes on the Newton path (`ok`) and those done with their Newton steps.
+    __m256i ok = valid, converged = zero;
+    __m256 z = Secant(z_a, z_b, nearest_a, nearest_b);
+    PacketCells cells;
+    std::memcpy(cells.block_index, c.block_index, sizeof(cells.block_index));
+    std::memcpy(cells.block, c.block, sizeof(cells.block));
     __m256 frac[3] = {}, gradient[3] = {};
     for (int k = 0; k < kNewtonIterations; ++k) {
       const __m256i active = AndNot(converged, ok);
-      const int active_bits = _mm256_movemask_ps(_mm256_castsi256_ps(active));
-      if (!active_bits) break;
-      // Sampler::Gather: the cell's corner 0 and the position in it, in voxel units.
-      // A lane's first cell is always loaded; the rows hold an earlier batch's values.
-      __m256i g[3], changed = zero, moved = k == 0 ? minus_one : zero, inside_block = minus_one;
-      __m256 f_new[3];
-      for (int a = 0; a < 3; ++a) {
-        const __m256 p = _mm256_add_ps(Set(origin_W_[a]), _mm256_mul_ps(z, dir[a]));
-        const __m256 q = _mm256_sub_ps(_mm256_mul_ps(p, Set(sampler_.inv_voxel())), Set(0.5f));
-        g[a] = Floor(q);
-        f_new[a] = _mm256_sub_ps(q, _mm256_cvtepi32_ps(g[a]));
-        moved =
-            _mm256_or_si256(moved, AndNot(_mm256_cmpeq_epi32(g[a], Load(cell_base[a])), minus_one));
-        Store(cell_base[a], _mm256_blendv_epi8(Load(cell_base[a]), g[a], active));
-        const __m256i b = _mm256_srai_epi32(g[a], kBlockShift);
-        changed = _mm256_or_si256(changed,
-                                  AndNot(_mm256_cmpeq_epi32(b, Load(block_index[a])), minus_one));
-        Store(block_index[a], _mm256_blendv_epi8(Load(block_index[a]), b, active));
-        // All eight corners in the block: corner 0 below its last voxel on every axis.
-        inside_block = _mm256_and_si256(
-            inside_block,
-            _mm256_cmpgt_epi32(_mm256_set1_epi32(kBlockMask),
-                               _mm256_and_si256(g[a], _mm256_set1_epi32(kBlockMask))));
-      }
-      Store(cell_i0, _mm256_blendv_epi8(Load(cell_i0), LinearIndex(g), active));
-      changed = _mm256_and_si256(changed, active);
-      for (int bits = _mm256_movemask_ps(_mm256_castsi256_ps(changed)); bits; bits &= bits - 1) {
-        const int l = std::countr_zero(unsigned(bits));
-        const TsdfBlock* found = sampler_.FindUncached(
-            BlockIndex{block_index[0][l], block_index[1][l], block_index[2][l]});
-        block[l] = found ? found : &kNoBlock;
-      }
-      // The corners of the lanes whose cell moved (LoadCorners, LoadCornersAcross).
-      const int inside_bits = _mm256_movemask_ps(_mm256_castsi256_ps(inside_block));
-      for (int bits = _mm256_movemask_ps(_mm256_castsi256_ps(_mm256_and_si256(moved, active)));
-           bits; bits &= bits - 1) {
-        const int l = std::countr_zero(unsigned(bits));
-        if ((inside_bits >> l) & 1) {
-          one_block |= 1u << l;
-          const int16_t* tsdf = block[l]->tsdf + cell_i0[l];
-          const uint16_t* weight = block[l]->weight + cell_i0[l];
-          for (int p = 0; p < 4; ++p) {
-            std::memcpy(&tsdf_pairs[p][l], tsdf + kCornerOffset[2 * p], sizeof(uint32_t));
-            std::memcpy(&weight_pairs[p][l], weight + kCornerOffset[2 * p], sizeof(uint32_t));
-          }
-          continue;
-        }
-        one_block &= ~(1u << l);
-        const TsdfBlock** blocks = across_block[l];
-        const int* index = across_index[l];
-        sampler_.CornersAcross(GlobalVoxelIndex{cell_base[0][l], cell_base[1][l], cell_base[2][l]},
-                               blocks, across_index[l]);
-        for (int p = 0; p < 4; ++p) {
-          const int lo = 2 * p, hi = 2 * p + 1;
-          tsdf_pairs[p][l] = uint32_t(uint16_t(blocks[lo]->tsdf[index[lo]])) |
-                             uint32_t(uint16_t(blocks[hi]->tsdf[index[hi]])) << 16;
-          weight_pairs[p][l] = uint32_t(blocks[lo]->weight[index[lo]]) |
-                               uint32_t(blocks[hi]->weight[index[hi]]) << 16;
-        }
-      }
-      // Decoded as LoadCorners does; a lane with an unobserved corner leaves the usual path.
-      __m256 t[8];
-      __m256i complete = minus_one;
-      const __m256i low16 = _mm256_set1_epi32(0xffff);
-      for (int p = 0; p < 4; ++p) {
-        const __m256i tsdf = Load(tsdf_pairs[p]), weight = Load(weight_pairs[p]);
-        t[2 * p] = Decode(_mm256_srai_epi32(_mm256_slli_epi32(tsdf, 16), 16));
-        t[2 * p + 1] = Decode(_mm256_srai_epi32(tsdf, 16));
-        complete = _mm256_and_si256(
-            complete, _mm256_and_si256(
-                          _mm256_cmpgt_epi32(_mm256_and_si256(weight, low16), min_weight_minus_one),
-                          _mm256_cmpgt_epi32(_mm256_srli_epi32(weight, 16), min_weight_minus_one)));
-      }
+      if (!_mm256_movemask_ps(_mm256_castsi256_ps(active))) break;
+      __m256 f, f_new[3], g_new[3];
+      const __m256i complete = SampleCells(cells, dir, z, active, &f, f_new, g_new);
       ok = AndNot(AndNot(complete, active), ok);
-      // ValueAndGradientSse2, lane by lane: edge j of four per axis, then the four summed in
-      // pairs.
-      const __m256 fx = f_new[0], fy = f_new[1], fz = f_new[2];
-      __m256 value[4], gx[4], gy[4], gz[4];
-      for (int j = 0; j < 4; ++j) {
-        const bool odd = j & 1, high = j >= 2;
-        const __m256 wx = Lerp(odd, fx), wy = Lerp(high, fy), wz = Lerp(high, fz);
-        const __m256 wy_edge = Lerp(odd, fy);
-        const __m256 d_z = _mm256_sub_ps(t[j + 4], t[j]);
-        static constexpr int kX[4][2] = {{1, 0}, {3, 2}, {5, 4}, {7, 6}};
-        static constexpr int kY[4][2] = {{2, 0}, {3, 1}, {6, 4}, {7, 5}};
-        const __m256 d_x = _mm256_sub_ps(t[kX[j][0]], t[kX[j][1]]);
-        const __m256 d_y = _mm256_sub_ps(t[kY[j][0]], t[kY[j][1]]);
-        const __m256 wxy = _mm256_mul_ps(wx, wy);
-        value[j] = _mm256_mul_ps(wxy, _mm256_add_ps(t[j], _mm256_mul_ps(fz, d_z)));
-        gx[j] = _mm256_mul_ps(_mm256_mul_ps(wy_edge, wz), d_x);
-        gy[j] = _mm256_mul_ps(_mm256_mul_ps(wx, wz), d_y);
-        gz[j] = _mm256_mul_ps(wxy, d_z);
-      }
-      const __m256 f = Sum4(value), g_new[3] = {Sum4(gx), Sum4(gy), Sum4(gz)};
       // Refine's Newton step; Eigen's dot sums x + (y + z).
       const __m256 slope = _mm256_mul_ps(
           _mm256_add_ps(
@@ -1466,6 +1534,76 @@ class RayCaster {
     }
     ok = _mm256_and_si256(ok, converged);
 
+    *deferred = unsigned(_mm256_movemask_ps(_mm256_castsi256_ps(AndNot(ok, valid))));
+    return FinishCrossings(c, cells, ok, zero, z, frac, gradient, results);
+  }
+
+  // Refine's bracket (regula falsi on the trilinear interpolant, Bracket) for each of the
+  // crossings, then normal and colour, in AVX2 lanes with the scalar code's float operations in
+  // its order; bit j of the result as RefineCrossings'. A lane that meets an unobserved corner
+  // is refined by Cross itself.
+  VOXPLAN_TARGET_AVX2 unsigned BracketCrossings(const Crossings& c, RayResult results[kPacket]) {
+    using namespace avx2;
+    const __m256 dir[3] = {LoadF(c.dir_W[0]), LoadF(c.dir_W[1]), LoadF(c.dir_W[2])};
+    const __m256 voxel_z = LoadF(c.voxel_z);
+    __m256i live =
+        _mm256_cmpgt_epi32(_mm256_set1_epi32(c.count), _mm256_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7));
+    __m256i scalar = _mm256_setzero_si256();
+    PacketCells cells;
+    std::memcpy(cells.block_index, c.block_index, sizeof(cells.block_index));
+    std::memcpy(cells.block, c.block, sizeof(cells.block));
+    const __m256 zero_f = _mm256_setzero_ps();
+    __m256 frac[3], gradient[3];
+    __m256 za = LoadF(c.z_a), zb = LoadF(c.z_b);
+    __m256 fa = SampleLive(cells, dir, za, &live, &scalar, frac, gradient);
+    __m256 fb = SampleLive(cells, dir, zb, &live, &scalar, frac, gradient);
+    // Moved back while f_a < 0, then on while f_b >= 0, a voxel at a time.
+    for (int side = 0; side < 2; ++side)
+      for (int k = 0; k < kMaxBracketShifts; ++k) {
+        const __m256i shift = _mm256_and_si256(
+            live, _mm256_castps_si256(side == 0 ? _mm256_cmp_ps(fa, zero_f, _CMP_LT_OQ)
+                                                : _mm256_cmp_ps(fb, zero_f, _CMP_GE_OQ)));
+        if (!_mm256_movemask_ps(_mm256_castsi256_ps(shift))) break;
+        __m256i sampled = shift;
+        if (side == 0) {
+          zb = Blend(zb, za, shift), fb = Blend(fb, fa, shift);
+          za = Blend(za, _mm256_sub_ps(za, voxel_z), shift);
+          fa = Blend(fa, SampleLive(cells, dir, za, &sampled, &scalar, frac, gradient), sampled);
+        } else {
+          za = Blend(za, zb, shift), fa = Blend(fa, fb, shift);
+          zb = Blend(zb, _mm256_add_ps(zb, voxel_z), shift);
+          fb = Blend(fb, SampleLive(cells, dir, zb, &sampled, &scalar, frac, gradient), sampled);
+        }
+        live = AndNot(AndNot(sampled, shift), live);
+      }
+    const __m256i straddles = _mm256_castps_si256(_mm256_and_ps(
+        _mm256_cmp_ps(fa, zero_f, _CMP_GE_OQ), _mm256_cmp_ps(fb, zero_f, _CMP_LT_OQ)));
+    live = _mm256_and_si256(live, straddles);  // the others have no zero
+    // Regula falsi; a lane meeting an unobserved corner goes to Cross.
+    for (int k = 0; k < kSecantIterations; ++k) {
+      const __m256 zr = Secant(za, zb, fa, fb);
+      const __m256 f = SampleLive(cells, dir, zr, &live, &scalar, frac, gradient);
+      const __m256 positive = _mm256_cmp_ps(f, zero_f, _CMP_GE_OQ);
+      const __m256i to_a = _mm256_and_si256(live, _mm256_castps_si256(positive));
+      const __m256i to_b = AndNot(_mm256_castps_si256(positive), live);
+      za = Blend(za, zr, to_a), fa = Blend(fa, f, to_a);
+      zb = Blend(zb, zr, to_b), fb = Blend(fb, f, to_b);
+    }
+    // The cell at the final point gives the gradient and the colour.
+    const __m256 z_out = Secant(za, zb, fa, fb);
+    SampleLive(cells, dir, z_out, &live, &scalar, frac, gradient);
+    return FinishCrossings(c, cells, live, scalar, z_out, frac, gradient, results);
+  }
+
+  // The results of a batch of crossings: for the `ok` lanes the hit at z with the normal from
+  // `gradient` and the colour of the cell at `frac`, for the `scalar` ones Cross; bit j of the
+  // result as RefineCrossings'.
+  VOXPLAN_TARGET_AVX2 unsigned FinishCrossings(const Crossings& c, const PacketCells& cells,
+                                               __m256i ok, __m256i scalar, __m256 z,
+                                               const __m256 frac[3], const __m256 gradient[3],
+                                               RayResult results[kPacket]) {
+    using namespace avx2;
+    const __m256i zero = _mm256_setzero_si256();
     alignas(32) float z_out[kPacket], normal[3][kPacket];
     alignas(32) uint32_t color[kPacket];
     _mm256_store_ps(z_out, z);
@@ -1497,19 +1635,20 @@ class RayCaster {
       auto& color_pairs = rows_.color_pairs;
       for (int bits = _mm256_movemask_ps(_mm256_castsi256_ps(ok)); bits; bits &= bits - 1) {
         const int l = std::countr_zero(unsigned(bits));
-        if ((one_block >> l) & 1) {
-          const uint8_t* channel[3] = {block[l]->r, block[l]->g, block[l]->b};
+        if ((cells.one_block >> l) & 1) {
+          const uint8_t* channel[3] = {cells.block[l]->r, cells.block[l]->g, cells.block[l]->b};
           for (int ch = 0; ch < 3; ++ch)
             for (int p = 0; p < 4; ++p) {
               uint16_t pair;
-              std::memcpy(&pair, channel[ch] + cell_i0[l] + kCornerOffset[2 * p], sizeof(pair));
+              std::memcpy(&pair, channel[ch] + cells.i0[l] + kCornerOffset[2 * p], sizeof(pair));
               color_pairs[ch][p][l] = pair;
             }
           continue;
         }
         for (int p = 0; p < 4; ++p) {
-          const TsdfBlock &lo = *across_block[l][2 * p], &hi = *across_block[l][2 * p + 1];
-          const int i_lo = across_index[l][2 * p], i_hi = across_index[l][2 * p + 1];
+          const TsdfBlock &lo = *cells.across_block[l][2 * p],
+                          &hi = *cells.across_block[l][2 * p + 1];
+          const int i_lo = cells.across_index[l][2 * p], i_hi = cells.across_index[l][2 * p + 1];
           color_pairs[0][p][l] = uint32_t(lo.r[i_lo]) | uint32_t(hi.r[i_hi]) << 8;
           color_pairs[1][p][l] = uint32_t(lo.g[i_lo]) | uint32_t(hi.g[i_hi]) << 8;
           color_pairs[2][p][l] = uint32_t(lo.b[i_lo]) | uint32_t(hi.b[i_hi]) << 8;
@@ -1537,18 +1676,20 @@ class RayCaster {
     }
 
     const int ok_bits = _mm256_movemask_ps(_mm256_castsi256_ps(ok));
+    const int scalar_bits = _mm256_movemask_ps(_mm256_castsi256_ps(scalar));
     unsigned found = 0;
     for (int j = 0; j < c.count; ++j) {
       const Eigen::Vector3f dir_W(c.dir_W[0][j], c.dir_W[1][j], c.dir_W[2][j]);
       RayResult& result = results[j];
       result = RayResult{};
       result.status = RayStatus::kFree;  // the march met observed voxels
-      if (!((ok_bits >> j) & 1)) {
+      if ((scalar_bits >> j) & 1) {
         found |= unsigned(Cross(dir_W, c.z_a[j], c.z_b[j], int16_t(c.tsdf_a[j]),
                                 int16_t(c.tsdf_b[j]), c.voxel_z[j], &result, /*newton=*/false))
                  << j;
         continue;
       }
+      if (!((ok_bits >> j) & 1)) continue;  // the bracket found no zero
       found |= 1u << j;
       if (z_out[j] < params_.min_depth_m || z_out[j] > params_.max_depth_m) continue;  // kFree
       result.status = RayStatus::kHit;
