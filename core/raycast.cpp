@@ -6,6 +6,8 @@
 #include <cstddef>
 #include <cstring>
 #include <limits>
+#include <memory>
+#include <type_traits>
 #include <vector>
 
 #include "core/parallel.h"
@@ -778,7 +780,7 @@ VOXPLAN_TARGET_AVX2 inline __m256i LinearIndex(const __m256i g[3]) {
 
 // A pixel whose ray has a depth range to march.
 struct RayTask {
-  size_t pixel;
+  size_t pixel;  // where the result goes (Raycast: the index in its batch's images)
   int u, v;
   float z_begin, z_end;
   // >= 0: [z_skipped, z_begin) was skipped (it holds no surface); marched as well when the march
@@ -1719,6 +1721,14 @@ class RayCaster {
   float step_scale_;  // stored fixed-point TSDF to a step in metres along the ray
 };
 
+// n pixels of an image row. Eigen's fixed-size vectors are plain floats, but not trivially
+// copy-assignable by the letter of the type: memcpy through void*.
+template <class T>
+void CopyPixels(T* dst, const T* src, size_t n) {
+  static_assert(std::is_standard_layout_v<T> && std::is_trivially_destructible_v<T>);
+  std::memcpy(static_cast<void*>(dst), static_cast<const void*>(src), n * sizeof(T));
+}
+
 }  // namespace
 
 void Raycast(const TsdfVolume& volume, const PinholeCamera& camera, const Pose3f& T_W_C,
@@ -1754,19 +1764,15 @@ void Raycast(const TsdfVolume& volume, const PinholeCamera& camera, const Pose3f
   const float surface_margin = 0.5f * volume.voxel_size_m();
   const int tiles_x = (w + kTile - 1) / kTile, tiles_y = (h + kTile - 1) / kTile;
 
-  auto write = [&](size_t px, const RayResult& ray, const Eigen::Vector3f& dir_W) {
-    images.status.data[px] = uint8_t(ray.status);
-    if (ray.status == RayStatus::kHit) {
-      images.depth.data[px] = ray.z;
-      images.vertex_W.data[px] = origin_W + ray.z * dir_W;
-      images.normal_W.data[px] = ray.normal_W;
-      images.color.data[px] = ray.color;
-    } else {
-      images.depth.data[px] = 0.f;
-      images.vertex_W.data[px] = nan3;
-      images.normal_W.data[px] = nan3;
-      images.color.data[px] = 0;
-    }
+  // Results go to a batch's own images first (a pixel's index there is its tile's place in
+  // the batch, then its row and column in the tile) and then row by row to `images`: scattered
+  // stores of a few bytes into images far larger than the caches were the slower way.
+  constexpr int kBatchPixels = kTilesPerBatch * kTile * kTile;
+  struct BatchImages {
+    float depth[kBatchPixels];
+    Eigen::Vector3f vertex_W[kBatchPixels], normal_W[kBatchPixels];
+    uint32_t color[kBatchPixels];
+    uint8_t status[kBatchPixels];
   };
 
 #if VOXPLAN_RAYCAST_AVX2
@@ -1775,20 +1781,38 @@ void Raycast(const TsdfVolume& volume, const PinholeCamera& camera, const Pose3f
   ParallelFor(size_t(tiles_x) * size_t(tiles_y), kTilesPerBatch, [&](size_t begin, size_t end) {
     RayCaster caster(volume, params, origin_W, d0_W, du_W, dv_W);
     const RayResult unobserved;
-    RayTask tasks[kTilesPerBatch * kTile * kTile];
+    RayTask tasks[kBatchPixels];
+    auto batch = std::make_unique<BatchImages>();
+    BatchImages& out = *batch;
+    auto write = [&](size_t i, const RayResult& ray, const Eigen::Vector3f& dir_W) {
+      out.status[i] = uint8_t(ray.status);
+      if (ray.status == RayStatus::kHit) {
+        out.depth[i] = ray.z;
+        out.vertex_W[i] = origin_W + ray.z * dir_W;
+        out.normal_W[i] = ray.normal_W;
+        out.color[i] = ray.color;
+      } else {
+        out.depth[i] = 0.f;
+        out.vertex_W[i] = nan3;
+        out.normal_W[i] = nan3;
+        out.color[i] = 0;
+      }
+    };
     for (size_t first = begin; first < end; first += kTilesPerBatch) {
+      const size_t last = std::min(first + kTilesPerBatch, end);
       // First the pixels whose rays have a range to march, tile by tile and row by row; the
       // others are written as unobserved at once.
       size_t num_tasks = 0;
-      for (size_t tile = first; tile < std::min(first + kTilesPerBatch, end); ++tile) {
+      for (size_t tile = first; tile < last; ++tile) {
         const int u0 = int(tile % size_t(tiles_x)) * kTile,
                   v0 = int(tile / size_t(tiles_x)) * kTile;
         const int u_end = std::min(u0 + kTile, w), v_end = std::min(v0 + kTile, h);
         for (int v = v0; v < v_end; ++v) {
           const size_t range_row = size_t(v / kRangeCell) * size_t(range.cols);
           const size_t surface_row = size_t(v / kSurfaceCell) * size_t(range.surface_cols);
+          const size_t row_i = (tile - first) * kTile * kTile + size_t(v - v0) * kTile;
           for (int u = u0; u < u_end; ++u) {
-            const size_t px = size_t(v) * size_t(w) + size_t(u);
+            const size_t i = row_i + size_t(u - u0);
             if (usable) {
               const size_t cell = range_row + size_t(u / kRangeCell);
               const float z_all = std::max(range.z_min[cell], z_start);
@@ -1801,21 +1825,34 @@ void Raycast(const TsdfVolume& volume, const PinholeCamera& camera, const Pose3f
                     z_all);
                 const bool skip = z_surface <= z_end && z_surface > z_all;
                 tasks[num_tasks++] = {
-                    px, u, v, skip ? z_surface : z_all, z_end, skip ? z_all : -1.f};
+                    i, u, v, skip ? z_surface : z_all, z_end, skip ? z_all : -1.f};
                 continue;
               }
             }
-            write(px, unobserved, d0_W);
+            write(i, unobserved, d0_W);
           }
         }
       }
 #if VOXPLAN_RAYCAST_AVX2
-      if (packets) {
+      if (packets)
         caster.MarchPackets(tasks, num_tasks, write);
-        continue;
-      }
+      else
 #endif
-      caster.MarchInterleaved(tasks, num_tasks, write);
+        caster.MarchInterleaved(tasks, num_tasks, write);
+      for (size_t tile = first; tile < last; ++tile) {
+        const int u0 = int(tile % size_t(tiles_x)) * kTile,
+                  v0 = int(tile / size_t(tiles_x)) * kTile;
+        const size_t n = size_t(std::min(u0 + kTile, w) - u0);
+        for (int v = v0; v < std::min(v0 + kTile, h); ++v) {
+          const size_t i = (tile - first) * kTile * kTile + size_t(v - v0) * kTile;
+          const size_t px = size_t(v) * size_t(w) + size_t(u0);
+          CopyPixels(&images.status.data[px], &out.status[i], n);
+          CopyPixels(&images.depth.data[px], &out.depth[i], n);
+          CopyPixels(&images.vertex_W.data[px], &out.vertex_W[i], n);
+          CopyPixels(&images.normal_W.data[px], &out.normal_W[i], n);
+          CopyPixels(&images.color.data[px], &out.color[i], n);
+        }
+      }
     }
   });
 }
