@@ -10,6 +10,7 @@
 #include <type_traits>
 #include <vector>
 
+#include "core/block_map.h"
 #include "core/parallel.h"
 #include "core/raycast_kernels.h"
 
@@ -168,41 +169,28 @@ struct Chunk {
   std::vector<VisibleBlock> visible;
 };
 
-// The negative-brick masks of the visible blocks by block index (open addressing), for the
-// neighbour tests of SplatBricks.
+// The negative-brick masks of the visible blocks by block index, for the neighbour tests of
+// SplatBricks.
 class BrickMaskTable {
  public:
   void Build(const std::vector<Chunk>& chunks) {
-    size_t n = 0;
-    for (const Chunk& chunk : chunks) n += chunk.visible.size();
-    bits_ = std::max(int(std::bit_width(2 * n)), 4);
-    keys_.assign(size_t(1) << bits_, kEmpty);
-    masks_.resize(keys_.size());
     for (const Chunk& chunk : chunks)
       for (const VisibleBlock& v : chunk.visible) {
         if (!v.bricks) continue;
-        const uint64_t key = PackBlockIndex(v.index);
-        size_t i = Slot(key);
-        while (keys_[i] != kEmpty) i = (i + 1) & (keys_.size() - 1);
-        keys_[i] = key;
-        masks_[i] = v.bricks;
+        index_.Insert(v.index, uint32_t(masks_.size()));
+        masks_.push_back(v.bricks);
       }
   }
   // 0 for a block that is not visible or holds no negative voxel.
   uint64_t Find(BlockIndex b) const {
-    if (!InPackRange(b)) return 0;
-    const uint64_t key = PackBlockIndex(b);
-    for (size_t i = Slot(key);; i = (i + 1) & (keys_.size() - 1)) {
-      if (keys_[i] == key) return masks_[i];
-      if (keys_[i] == kEmpty) return 0;
-    }
+    // Indices beyond the packable range would alias; no visible block is there.
+    const uint32_t i = InPackRange(b) ? index_.Find(b) : BlockMap::kNoSlot;
+    return i == BlockMap::kNoSlot ? 0 : masks_[i];
   }
 
  private:
-  static constexpr uint64_t kEmpty = ~uint64_t{0};  // no packed index has all bits set
-  size_t Slot(uint64_t key) const { return size_t((key * 0x9e3779b97f4a7c15ull) >> (64 - bits_)); }
-  int bits_ = 4;
-  std::vector<uint64_t> keys_, masks_;
+  BlockMap index_;  // block -> its place in masks_
+  std::vector<uint64_t> masks_;
 };
 
 // Interior bricks. Where a ray first meets the negative bricks, it enters one, B, through a
