@@ -1314,6 +1314,12 @@ class RayCaster {
     size_t pixel[kPacket];
     int count = 0;
 
+    // The lanes holding a crossing (all bits set), for AVX2 code.
+    VOXPLAN_TARGET_AVX2 __m256i Lanes() const {
+      return _mm256_cmpgt_epi32(_mm256_set1_epi32(count),
+                                _mm256_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7));
+    }
+
     // Appends crossing j of `other`.
     void Append(const Crossings& other, int j) {
       const int i = count++;
@@ -1347,6 +1353,12 @@ class RayCaster {
     int across_index[kPacket][8];
     unsigned one_block = 0;  // bit l: lane l's cell lies in block[l]
     unsigned loaded = 0;     // bit l: lane l's rows hold its cell (else an earlier batch's)
+
+    // No cell loaded yet; each lane's block the one the march sampled last.
+    explicit PacketCells(const Crossings& c) {
+      std::memcpy(block_index, c.block_index, sizeof(block_index));
+      std::memcpy(block, c.block, sizeof(block));
+    }
   };
 
   // Sample (Sampler::Gather, then ValueAndGradientSse2 lane by lane) at depth z on the rays of
@@ -1482,14 +1494,11 @@ class RayCaster {
     const __m256 nearest_a = Decode(Load(c.tsdf_a)), nearest_b = Decode(Load(c.tsdf_b));
     const __m256 max_slope = Set(MaxSlope());
     const __m256 dq_dz = Set(sampler_.inv_voxel());
-    const __m256i valid =
-        _mm256_cmpgt_epi32(_mm256_set1_epi32(c.count), _mm256_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7));
+    const __m256i valid = c.Lanes();
     // Lanes on the Newton path (`ok`) and those done with their Newton steps.
     __m256i ok = valid, converged = zero;
     __m256 z = Secant(z_a, z_b, nearest_a, nearest_b);
-    PacketCells cells;
-    std::memcpy(cells.block_index, c.block_index, sizeof(cells.block_index));
-    std::memcpy(cells.block, c.block, sizeof(cells.block));
+    PacketCells cells(c);
     __m256 frac[3] = {}, gradient[3] = {};
     for (int k = 0; k < kNewtonIterations; ++k) {
       const __m256i active = AndNot(converged, ok);
@@ -1536,12 +1545,9 @@ class RayCaster {
     using namespace avx2;
     const __m256 dir[3] = {LoadF(c.dir_W[0]), LoadF(c.dir_W[1]), LoadF(c.dir_W[2])};
     const __m256 voxel_z = LoadF(c.voxel_z);
-    __m256i live =
-        _mm256_cmpgt_epi32(_mm256_set1_epi32(c.count), _mm256_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7));
+    __m256i live = c.Lanes();
     __m256i scalar = _mm256_setzero_si256();
-    PacketCells cells;
-    std::memcpy(cells.block_index, c.block_index, sizeof(cells.block_index));
-    std::memcpy(cells.block, c.block, sizeof(cells.block));
+    PacketCells cells(c);
     const __m256 zero_f = _mm256_setzero_ps();
     __m256 frac[3], gradient[3];
     __m256 za = LoadF(c.z_a), zb = LoadF(c.z_b);
