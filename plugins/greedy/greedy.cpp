@@ -1,8 +1,11 @@
 // GRD, the greedy baseline of Dong et al. 2019 §4, as a plugin, over the OMT pass's task views
-// with importance above the threshold. Two policies ("policy"):
-//  - "best" (default, the paper's GRD): the views are assigned greedily, best first, each to the
-//    robot with the fewest views so far (nearest among those), so the whole team is dispatched
-//    to the best views at once; each planned robot then takes the closest of its own views.
+// with importance above the threshold. Three policies ("policy"):
+//  - "best_view" (default; the issue's "each robot takes the best task view, nearest first"):
+//    the views, best first, each go to the nearest robot that holds none yet, so the whole team
+//    is dispatched to the best views at once (the paper's account of GRD: balanced, long drives).
+//  - "best": the views, best first, are dealt out to the robot with the fewest so far (nearest
+//    among those), and each planned robot takes the closest of its share: the paper's "assign
+//    greedily, then the closest of a robot's tasks" with every view assigned, a stronger baseline.
 //  - "nearest": each robot this call plans (robot index order) takes the nearest (geodesic) view
 //    that no other robot holds, a nearest-frontier baseline.
 // One task per robot per call either way; it plans again when the robot turns idle. Done when no
@@ -25,7 +28,10 @@ class GreedyPlanner : public vp::Planner {
     JsonOptions json("greedy", config.json);
     options_ = ReadCommonOptions(json);
     claim_radius_m_ = json.Number("claim_radius_m", claim_radius_m_, 0.0, 100.0);
-    best_ = json.Choice("policy", "best", {"best", "nearest"}) == "best";
+    const std::string policy = json.Choice("policy", "best_view", {"best_view", "best", "nearest"});
+    policy_ = policy == "best_view" ? Policy::kBestView
+              : policy == "best"    ? Policy::kBest
+                                    : Policy::kNearest;
     json.RejectUnknownKeys();
   }
 
@@ -44,8 +50,9 @@ class GreedyPlanner : public vp::Planner {
         }
       }
     }
-    const int tasks = best_ ? PlanBest(world, out, b, planned, claimed)
-                            : PlanNearest(world, out, b, planned, claimed);
+    const int tasks = policy_ == Policy::kNearest
+                          ? PlanNearest(world, out, b, planned, claimed)
+                          : PlanBest(world, out, b, planned, claimed, policy_ == Policy::kBestView);
     ReportViews(out, b, tasks, settled_);
   }
 
@@ -70,13 +77,15 @@ class GreedyPlanner : public vp::Planner {
     return tasks;
   }
 
+  // "best" and, with `one_each`, "best_view" (a robot holding a view takes no more).
   // The assignment runs over every robot, not only the planned ones, so that a robot's share of
   // the best views does not depend on which event triggered the call. A robot keeping its queue
   // (not planned) starts with its queued tasks counted, so an idle robot is served first instead
   // of losing the best remaining view to a busy one; the views in those queues are out of the
   // pool (claimed), and what a busy robot is assigned here is dropped (it keeps its queue).
   int PlanBest(const vp::WorldView& world, vp::PlanOutput& out, const BaselineWorld& b,
-               const std::vector<uint8_t>& planned, const std::vector<uint8_t>& claimed) {
+               const std::vector<uint8_t>& planned, const std::vector<uint8_t>& claimed,
+               bool one_each) {
     const size_t robots = planned.size();
     std::vector<std::vector<uint8_t>> allowed(robots);  // per robot: important, not just failed
     std::vector<size_t> count(robots, 0);
@@ -102,7 +111,8 @@ class GreedyPlanner : public vp::Planner {
           to = int(r);
         }
       }
-      if (to < 0) continue;  // nobody may take it
+      if (to < 0) continue;                             // nobody may take it
+      if (one_each && count[size_t(to)] > 0) continue;  // robots that may take it hold one
       assigned[size_t(to)][v] = 1;
       ++count[size_t(to)];
     }
@@ -124,7 +134,8 @@ class GreedyPlanner : public vp::Planner {
   CommonOptions options_;
   SettledCells settled_;         // cells looked at in vain, across calls
   double claim_radius_m_ = 0.5;  // a view this close to another robot's queued task is its
-  bool best_ = true;             // "policy": "best" (the paper's GRD) or "nearest"
+  enum class Policy { kBestView, kBest, kNearest };  // "policy", see the top of the file
+  Policy policy_ = Policy::kBestView;
 };
 
 }  // namespace

@@ -458,7 +458,8 @@ TEST(Planners, SettleViewsThatKeepComingBackAndFinish) {
 TEST(Planners, GreedyGivesDistinctRobotsDistinctViews) {
   // Four robots, two per room: the pairs start at the same nearest view and must split.
   const test::RasterWorld world = test::ApartmentWorld(8.f, 6.f, 0.05f, 4, 5.5f, 4.f);
-  for (const char* config : {R"({"policy": "best"})", R"({"policy": "nearest"})"}) {
+  for (const char* config :
+       {R"({"policy": "best_view"})", R"({"policy": "best"})", R"({"policy": "nearest"})"}) {
     auto planner = MustLoad("greedy", config);
     ASSERT_TRUE(planner);
     const PlanResult r = MustPlan(*planner, world);
@@ -478,7 +479,7 @@ TEST(Planners, GreedyGivesDistinctRobotsDistinctViews) {
 // faces away, so it has not looked at it), and a large unknown block U at the right end; robot 1
 // waits in the top left corner, farther from U than robot 0. With kappa 1 the pass extracts two
 // views, P first (its cells have the lowest indices) and then one of U, the more important.
-test::RasterWorld PocketAndBlockWorld() {
+test::RasterWorld PocketAndBlockWorld(bool with_robot_1 = true) {
   test::RasterWorld world(120, 40, 0.05f);
   world.Walls();
   world.Fill(4, 1, 11, 6, FloorCell::kUnknown);      // P
@@ -486,7 +487,7 @@ test::RasterWorld PocketAndBlockWorld() {
   world.Finish();
   world.set_surface_weight(1000.f);  // only unknown space is worth a view
   world.AddRobot(20, 12, 0.18f).theta_rad = 0.f;
-  world.AddRobot(8, 30, 0.18f).theta_rad = 1.5708f;
+  if (with_robot_1) world.AddRobot(8, 30, 0.18f).theta_rad = 1.5708f;
   return world;
 }
 
@@ -496,7 +497,7 @@ TEST(Planners, GreedyBestSendsTheTeamToTheBestViewsNotTheNearest) {
   auto in_pocket = [&](const PlannerTask& t) { return int(t.tag % uint32_t(width)) <= 12; };
   auto in_block = [&](const PlannerTask& t) { return int(t.tag % uint32_t(width)) >= 99; };
   std::map<std::string, PlanResult> results;
-  for (const char* policy : {"best", "nearest"}) {
+  for (const char* policy : {"best_view", "best", "nearest"}) {
     auto planner = MustLoad("greedy", std::string(R"({"kappa": 1, "policy": ")") + policy + "\"}");
     ASSERT_TRUE(planner);
     results[policy] = MustPlan(*planner, world);
@@ -504,22 +505,42 @@ TEST(Planners, GreedyBestSendsTheTeamToTheBestViewsNotTheNearest) {
     ASSERT_EQ(Diagnostics(r).at("views_important"), 2.0) << policy;
     for (const RobotPlan& plan : r.robots) ASSERT_EQ(plan.tasks.size(), 1u) << policy;
   }
-  // best: U, the better view, goes to the nearer of the two robots (both hold none yet), robot
-  // 0; P to the robot with fewer views, robot 1, although robot 0 stands next to it.
-  EXPECT_TRUE(in_block(results["best"].robots[0].tasks[0]));
-  EXPECT_TRUE(in_pocket(results["best"].robots[1].tasks[0]));
+  // best and best_view: U, the better view, goes to the nearer of the two robots (both hold
+  // none yet), robot 0; P to the robot with fewer views, robot 1, although robot 0 stands next
+  // to it.
+  for (const char* policy : {"best_view", "best"}) {
+    EXPECT_TRUE(in_block(results[policy].robots[0].tasks[0])) << policy;
+    EXPECT_TRUE(in_pocket(results[policy].robots[1].tasks[0])) << policy;
+  }
   // nearest: robot 0 plans first and takes P, robot 1 what is left.
   EXPECT_TRUE(in_pocket(results["nearest"].robots[0].tasks[0]));
   EXPECT_TRUE(in_block(results["nearest"].robots[1].tasks[0]));
-  // Without the default, best is what runs.
-  auto plain = MustLoad("greedy", R"({"kappa": 1})");
+}
+
+TEST(Planners, GreedyBestViewTakesTheBestViewWhereBestTakesTheClosestOfItsShare) {
+  // Robot 0 alone, kappa 2: both views, P (next to it) and U (the better one), are its own.
+  const test::RasterWorld world = PocketAndBlockWorld(/*with_robot_1=*/false);
+  const int width = world.Floor().width;
+  std::map<std::string, PlanResult> results;
+  for (const char* policy : {"best_view", "best"}) {
+    auto planner = MustLoad("greedy", std::string(R"({"kappa": 2, "policy": ")") + policy + "\"}");
+    ASSERT_TRUE(planner);
+    results[policy] = MustPlan(*planner, world);
+    ASSERT_EQ(Diagnostics(results[policy]).at("views_important"), 2.0) << policy;
+    ASSERT_EQ(results[policy].robots[0].tasks.size(), 1u) << policy;
+  }
+  EXPECT_GE(int(results["best_view"].robots[0].tasks[0].tag % uint32_t(width)), 99);  // U
+  EXPECT_LE(int(results["best"].robots[0].tasks[0].tag % uint32_t(width)), 12);       // P
+  // Without a policy, best_view is what runs.
+  auto plain = MustLoad("greedy", R"({"kappa": 2})");
   ASSERT_TRUE(plain);
-  EXPECT_EQ(Bytes(MustPlan(*plain, world)), Bytes(results["best"]));
+  EXPECT_EQ(Bytes(MustPlan(*plain, world)), Bytes(results["best_view"]));
 }
 
 TEST(Planners, GreedyPoliciesAreDeterministicAndCheckedAtLoad) {
   const test::RasterWorld world = SmallApartment();
-  for (const char* config : {R"({"policy": "best"})", R"({"policy": "nearest"})"}) {
+  for (const char* config :
+       {R"({"policy": "best_view"})", R"({"policy": "best"})", R"({"policy": "nearest"})"}) {
     auto a = MustLoad("greedy", config, 3);
     auto b = MustLoad("greedy", config, 3);
     ASSERT_TRUE(a && b);
@@ -535,7 +556,8 @@ TEST(Planners, GreedyPoliciesAreDeterministicAndCheckedAtLoad) {
 }
 
 TEST(Planners, GreedyOnIdlePlansOnlyTheIdleRobotAroundOthersQueues) {
-  for (const char* config : {R"({"policy": "best"})", R"({"policy": "nearest"})"}) {
+  for (const char* config :
+       {R"({"policy": "best_view"})", R"({"policy": "best"})", R"({"policy": "nearest"})"}) {
     test::RasterWorld world = test::ApartmentWorld(8.f, 6.f, 0.05f, 2, 5.5f, 4.f);
     auto planner = MustLoad("greedy", config);
     ASSERT_TRUE(planner);
@@ -557,6 +579,7 @@ TEST(Planners, GreedyOnIdlePlansOnlyTheIdleRobotAroundOthersQueues) {
 
 TEST(Planners, BaselinesDoNotRetryAFailedViewAtOnce) {
   const std::vector<std::pair<std::string, std::string>> planners = {
+      {"greedy", R"({"policy": "best_view"})"},
       {"greedy", R"({"policy": "best"})"},
       {"greedy", R"({"policy": "nearest"})"},
       {"voronoi", "{}"}};
