@@ -7,7 +7,9 @@
 #include <cstdio>
 #include <functional>
 #include <random>
+#include <string>
 #include <tuple>
+#include <utility>
 #include <vector>
 
 #include "core/parallel.h"
@@ -96,47 +98,51 @@ TEST(Raycast, SphereDepthNormalsColourAndVertices) {
   const TsdfVolume volume = FillExact([&](const Eigen::Vector3f& p) { return sphere.Sdf(p); },
                                       sphere.c - Eigen::Vector3f::Constant(0.45f),
                                       sphere.c + Eigen::Vector3f::Constant(0.45f));
-  const PinholeCamera cam = TestCamera(160, 120);
-  const Pose3f T_W_C = LookAt(sphere.c + Eigen::Vector3f(0.9f, -0.5f, 0.3f), sphere.c);
-  const RaycastImages images = Raycast(volume, cam, T_W_C);
-  ASSERT_EQ(images.depth.width, cam.width);
-  ASSERT_EQ(images.status.height, cam.height);
+  // Also a size that is not a multiple of the 16-pixel tiles: partial tile rows and columns.
+  for (const auto& [width, height] : {std::pair{160, 120}, std::pair{157, 117}}) {
+    SCOPED_TRACE(std::to_string(width) + "x" + std::to_string(height));
+    const PinholeCamera cam = TestCamera(width, height);
+    const Pose3f T_W_C = LookAt(sphere.c + Eigen::Vector3f(0.9f, -0.5f, 0.3f), sphere.c);
+    const RaycastImages images = Raycast(volume, cam, T_W_C);
+    ASSERT_EQ(images.depth.width, cam.width);
+    ASSERT_EQ(images.status.height, cam.height);
 
-  const DepthImage truth = test::RenderDepth(sphere, cam, T_W_C);
-  const Errors e = Compare(images, truth, cam, T_W_C, [&](const Eigen::Vector3f& p) {
-    return Eigen::Vector3f((p - sphere.c).normalized());
-  });
-  std::printf("sphere: depth error median %.4f max %.4f voxel, normals max %.3f deg, %zu px\n",
-              e.median_vox, e.max_vox, e.max_normal_deg, e.checked);
-  ASSERT_GT(e.checked, 3000u);
-  EXPECT_EQ(e.missed, 0u);
-  EXPECT_LE(e.median_vox, kMedianDepthVox);
-  EXPECT_LE(e.max_vox, kMaxDepthVox);
-  EXPECT_LE(e.max_normal_deg, kMaxNormalDeg);
+    const DepthImage truth = test::RenderDepth(sphere, cam, T_W_C);
+    const Errors e = Compare(images, truth, cam, T_W_C, [&](const Eigen::Vector3f& p) {
+      return Eigen::Vector3f((p - sphere.c).normalized());
+    });
+    std::printf("sphere: depth error median %.4f max %.4f voxel, normals max %.3f deg, %zu px\n",
+                e.median_vox, e.max_vox, e.max_normal_deg, e.checked);
+    ASSERT_GT(e.checked, 3000u);
+    EXPECT_EQ(e.missed, 0u);
+    EXPECT_LE(e.median_vox, kMedianDepthVox);
+    EXPECT_LE(e.max_vox, kMaxDepthVox);
+    EXPECT_LE(e.max_normal_deg, kMaxNormalDeg);
 
-  size_t hits = 0;
-  for (size_t i = 0; i < images.status.data.size(); ++i) {
-    const int u = int(i % size_t(cam.width)), v = int(i / size_t(cam.width));
-    if (images.status.data[i] != uint8_t(RayStatus::kHit)) {
-      EXPECT_EQ(images.depth.data[i], 0.f);
-      EXPECT_TRUE(images.vertex_W.data[i].array().isNaN().all());
-      EXPECT_TRUE(images.normal_W.data[i].array().isNaN().all());
-      EXPECT_EQ(images.color.data[i], 0u);
-      continue;
+    size_t hits = 0;
+    for (size_t i = 0; i < images.status.data.size(); ++i) {
+      const int u = int(i % size_t(cam.width)), v = int(i / size_t(cam.width));
+      if (images.status.data[i] != uint8_t(RayStatus::kHit)) {
+        EXPECT_EQ(images.depth.data[i], 0.f);
+        EXPECT_TRUE(images.vertex_W.data[i].array().isNaN().all());
+        EXPECT_TRUE(images.normal_W.data[i].array().isNaN().all());
+        EXPECT_EQ(images.color.data[i], 0u);
+        continue;
+      }
+      ++hits;
+      EXPECT_EQ(images.color.data[i], PackRgb(kR, kG, kB));
+      EXPECT_NEAR(images.normal_W.data[i].norm(), 1.f, 1e-4f);
+      // The vertex lies on the pixel's ray at the reported depth.
+      const Eigen::Vector3f expected =
+          T_W_C * cam.Unproject(float(u), float(v), images.depth.data[i]);
+      EXPECT_LT((images.vertex_W.data[i] - expected).norm(), 1e-5f);
+      EXPECT_LT(std::abs(sphere.Sdf(images.vertex_W.data[i])), 0.25f * kVoxel);
     }
-    ++hits;
-    EXPECT_EQ(images.color.data[i], PackRgb(kR, kG, kB));
-    EXPECT_NEAR(images.normal_W.data[i].norm(), 1.f, 1e-4f);
-    // The vertex lies on the pixel's ray at the reported depth.
-    const Eigen::Vector3f expected =
-        T_W_C * cam.Unproject(float(u), float(v), images.depth.data[i]);
-    EXPECT_LT((images.vertex_W.data[i] - expected).norm(), 1e-5f);
-    EXPECT_LT(std::abs(sphere.Sdf(images.vertex_W.data[i])), 0.25f * kVoxel);
+    // Rays past the silhouette cross allocated free space or nothing at all.
+    EXPECT_GT(Count(images, RayStatus::kFree) + Count(images, RayStatus::kUnobserved), 0u);
+    EXPECT_EQ(hits + Count(images, RayStatus::kFree) + Count(images, RayStatus::kUnobserved),
+              images.status.data.size());
   }
-  // Rays past the silhouette cross allocated free space or nothing at all.
-  EXPECT_GT(Count(images, RayStatus::kFree) + Count(images, RayStatus::kUnobserved), 0u);
-  EXPECT_EQ(hits + Count(images, RayStatus::kFree) + Count(images, RayStatus::kUnobserved),
-            images.status.data.size());
 }
 
 TEST(Raycast, BoxWithNegativeFy) {
