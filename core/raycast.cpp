@@ -1720,17 +1720,12 @@ class RayCaster {
 template <class T>
 void CopyPixels(T* dst, const T* src, size_t n) {
   static_assert(std::is_standard_layout_v<T> && std::is_trivially_destructible_v<T>);
-#if defined(__SSE2__)
-  // A whole tile row (the usual case) in 16-byte moves the compiler unrolls: a library call
-  // per row of 16 to 192 bytes cost more than the copy.
-  constexpr size_t kRowBytes = kTile * sizeof(T);
-  if (n == size_t(kTile) && kRowBytes % 16 == 0) {
-    auto* d = reinterpret_cast<__m128i*>(static_cast<void*>(dst));
-    const auto* s = reinterpret_cast<const __m128i*>(static_cast<const void*>(src));
-    for (size_t k = 0; k < kRowBytes / 16; ++k) _mm_storeu_si128(d + k, _mm_loadu_si128(s + k));
+  // A whole tile row (the usual case) as a copy of known size, which the compiler inlines as
+  // vector moves: a library call per row of 16 to 192 bytes cost more than the copy.
+  if (n == size_t(kTile)) {
+    std::memcpy(static_cast<void*>(dst), static_cast<const void*>(src), kTile * sizeof(T));
     return;
   }
-#endif
   std::memcpy(static_cast<void*>(dst), static_cast<const void*>(src), n * sizeof(T));
 }
 
