@@ -1,16 +1,35 @@
 #pragma once
 // Owned images. Depth is float metres (0 = invalid); colour is packed RGBX, 4 bytes per pixel,
 // so SIMD kernels can gather a pixel with one 32-bit load.
+#include <cstddef>
 #include <cstdint>
+#include <new>
 #include <vector>
 
 namespace voxplan {
+
+// Pixels start on a cache line, so a row of whole lines can be written with streaming stores
+// (Raycast) and SIMD loads of a row's start never straddle lines.
+template <typename T>
+struct CacheLineAllocator {
+  using value_type = T;
+  static constexpr std::align_val_t kAlignment{64};
+  CacheLineAllocator() = default;
+  template <typename U>
+  CacheLineAllocator(const CacheLineAllocator<U>&) {}
+  T* allocate(size_t n) { return static_cast<T*>(::operator new(n * sizeof(T), kAlignment)); }
+  void deallocate(T* p, size_t) { ::operator delete(p, kAlignment); }
+  template <typename U>
+  bool operator==(const CacheLineAllocator<U>&) const {
+    return true;
+  }
+};
 
 template <typename T>
 struct Image {
   int width = 0;
   int height = 0;
-  std::vector<T> data;  // row-major, width * height
+  std::vector<T, CacheLineAllocator<T>> data;  // row-major, width * height
 
   Image() = default;
   Image(int w, int h, T fill = T{}) : width(w), height(h), data(size_t(w) * size_t(h), fill) {}

@@ -606,7 +606,7 @@ TEST(Determinism, OneAndTwoThreadsAgree) {
     for (int i = 0; i < 12; ++i) points.push_back(Center(3 + 4 * i % 56, 3 + 7 * i % 20));
     struct Out {
       std::vector<FloorCell> cells;
-      std::vector<float> clearance;
+      decltype(DepthImage::data) clearance;
       Eigen::MatrixXf distances;
     };
     return Out{map.cells(), ComputeClearance(map).data,

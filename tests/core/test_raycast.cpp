@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <cstdio>
 #include <functional>
 #include <random>
@@ -431,6 +432,17 @@ TEST(Raycast, OneAndTwoThreadsGiveIdenticalBytes) {
   RaycastImages reused = one;
   Raycast(volume, cam, T_W_C, {}, reused);
   test::ExpectSameImages(one, reused);
+
+  // Images start on a cache line, copies too, so at this width every tile row of depth, colour,
+  // vertices and normals is whole lines: the rows written with streaming stores above.
+  for (const RaycastImages* images : {&one, &reused}) {
+    for (const void* p : {static_cast<const void*>(images->depth.data.data()),
+                          static_cast<const void*>(images->color.data.data()),
+                          static_cast<const void*>(images->vertex_W.data.data()),
+                          static_cast<const void*>(images->normal_W.data.data()),
+                          static_cast<const void*>(images->status.data.data())})
+      EXPECT_EQ(reinterpret_cast<std::uintptr_t>(p) % 64, 0u);
+  }
 }
 
 // The AVX2 packet march (crossings refined eight at a time in AVX2 lanes) against the scalar

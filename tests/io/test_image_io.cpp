@@ -49,7 +49,7 @@ TEST(ImageIo, ReadsRealDepthPng) {
   ASSERT_TRUE(depth.ok()) << depth.status().message();
   EXPECT_EQ(depth->width, 640);
   EXPECT_EQ(depth->height, 480);
-  const float median = Median(depth->data);
+  const float median = Median({depth->data.begin(), depth->data.end()});
   EXPECT_GT(median, 0.5f);
   EXPECT_LT(median, 6.f);
   auto header = ReadPngHeader(path);
@@ -154,7 +154,7 @@ TEST(ImageIo, ReadsRealJpegAndPng) {
     EXPECT_EQ(color->width, 640) << rel;
     EXPECT_EQ(color->height, 480) << rel;
     // A real photo: many distinct colours and no X byte set.
-    std::vector<uint32_t> sorted = color->data;
+    std::vector<uint32_t> sorted(color->data.begin(), color->data.end());
     std::sort(sorted.begin(), sorted.end());
     EXPECT_GT(std::unique(sorted.begin(), sorted.end()) - sorted.begin(), 1000) << rel;
     EXPECT_EQ(sorted.back() >> 24, 0u);
