@@ -8,8 +8,8 @@
 
 namespace voxplan {
 
-// Pixels start on a cache line, so a row of whole lines can be written with streaming stores
-// (Raycast) and SIMD loads of a row's start never straddle lines.
+// Pixels start on a cache line, so rows of whole lines can be written with streaming stores
+// (Raycast's outputs).
 template <typename T>
 struct CacheLineAllocator {
   using value_type = T;
