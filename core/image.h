@@ -3,22 +3,38 @@
 // so SIMD kernels can gather a pixel with one 32-bit load.
 #include <cstddef>
 #include <cstdint>
+#include <cstdlib>
+#include <limits>
 #include <new>
 #include <vector>
 
 namespace voxplan {
 
 // Pixels start on a cache line, so rows of whole lines can be written with streaming stores
-// (Raycast's outputs).
+// (Raycast's outputs). Over-allocated from malloc and aligned by hand, the offset kept in the
+// byte before the pixels: the aligned operator new (memalign) left glibc's heap fragmented,
+// peak RSS of a 200-frame fusion 61 -> 256 MB.
 template <typename T>
 struct CacheLineAllocator {
   using value_type = T;
-  static constexpr std::align_val_t kAlignment{64};
+  static constexpr size_t kAlignment = 64;
+  static_assert(alignof(T) <= kAlignment);
   CacheLineAllocator() = default;
   template <typename U>
   CacheLineAllocator(const CacheLineAllocator<U>&) {}
-  T* allocate(size_t n) { return static_cast<T*>(::operator new(n * sizeof(T), kAlignment)); }
-  void deallocate(T* p, size_t) { ::operator delete(p, kAlignment); }
+  T* allocate(size_t n) {
+    if (n > (std::numeric_limits<size_t>::max() - kAlignment) / sizeof(T)) throw std::bad_alloc();
+    auto* raw = static_cast<unsigned char*>(std::malloc(n * sizeof(T) + kAlignment));
+    if (!raw) throw std::bad_alloc();
+    // malloc aligns to at least 16, so the offset is 16 to 64 and fits the byte before.
+    const size_t offset = kAlignment - reinterpret_cast<uintptr_t>(raw) % kAlignment;
+    raw[offset - 1] = static_cast<unsigned char>(offset);
+    return reinterpret_cast<T*>(raw + offset);
+  }
+  void deallocate(T* p, size_t) {
+    auto* pixels = reinterpret_cast<unsigned char*>(p);
+    std::free(pixels - pixels[-1]);
+  }
   template <typename U>
   bool operator==(const CacheLineAllocator<U>&) const {
     return true;

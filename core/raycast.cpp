@@ -1851,8 +1851,8 @@ void Raycast(const TsdfVolume& volume, const PinholeCamera& camera, const Pose3f
               const float z_surface =
                   std::max(surface_row[u / kSurfaceCell] - surface_margin, z_all);
               const bool skip = z_surface <= z_end && z_surface > z_all;
-              tasks[num_tasks++] = {row_i + size_t(u - u0), u, v, skip ? z_surface : z_all, z_end,
-                                    skip ? z_all : -1.f};
+              const float z_begin = skip ? z_surface : z_all, z_skipped = skip ? z_all : -1.f;
+              tasks[num_tasks++] = {row_i + size_t(u - u0), u, v, z_begin, z_end, z_skipped};
             }
           }
         }
