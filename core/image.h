@@ -26,7 +26,7 @@ struct CacheLineAllocator {
     if (n > (std::numeric_limits<size_t>::max() - kAlignment) / sizeof(T)) throw std::bad_alloc();
     auto* raw = static_cast<unsigned char*>(std::malloc(n * sizeof(T) + kAlignment));
     if (!raw) throw std::bad_alloc();
-    // malloc aligns to at least 16, so the offset is 16 to 64 and fits the byte before.
+    // The offset, 1 to 64 (16 to 64 from glibc), fits the byte before the pixels.
     const size_t offset = kAlignment - reinterpret_cast<uintptr_t>(raw) % kAlignment;
     raw[offset - 1] = static_cast<unsigned char>(offset);
     return reinterpret_cast<T*>(raw + offset);
