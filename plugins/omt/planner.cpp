@@ -291,6 +291,7 @@ Status PlanOmt(const OccupancyRaster& raster, const ClearanceRaster* clearance_i
     RobotPlan& plan = result->robots[static_cast<std::size_t>(r)];
     plan.path = SamplePolyline(polyline, task_vertices[static_cast<std::size_t>(r)],
                                smoothing.sample_spacing_m);
+    plan.geodesic_length_m = PolylineLength(plan.path);
     const RobotState& robot = robots[static_cast<std::size_t>(r)];
     if (options.optimize_paths) {
       statuses[static_cast<std::size_t>(r)] = SmoothPath(clearance, smoothing, &plan.path);

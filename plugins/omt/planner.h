@@ -54,6 +54,7 @@ struct RobotPlan {
   std::vector<PathPoint> path;  // starts at the robot
   std::vector<double> yaw_rad;  // camera yaw per path point
   double length_m = 0.0;
+  double geodesic_length_m = 0.0;  // of the path before eq. 5 (equal to length_m under NoPO)
 };
 
 struct PlanResult {

@@ -30,6 +30,7 @@ class OmtPlanner : public vp::Planner {
     o.assign_unimportant_views = json.Flag("assign_unimportant_views", o.assign_unimportant_views);
     o.hand_out_unassigned = json.Flag("hand_out_unassigned", o.hand_out_unassigned);
     o.assignment.delta_m = json.Number("delta_m", o.assignment.delta_m, 0.0, 1e3);
+    o.smoothing.eta_cap_m = json.Number("eta_cap_m", o.smoothing.eta_cap_m, 0.05, 1e9);
     json.RejectUnknownKeys();
   }
 
@@ -91,9 +92,11 @@ class OmtPlanner : public vp::Planner {
     }
     for (int robot : result.assignment.task_robot) unassigned += robot < 0;
     double length_m = 0.0;
+    double geodesic_length_m = 0.0;
     int tasks = 0;
     for (const omt::RobotPlan& p : result.robots) {
       length_m += p.length_m;
+      geodesic_length_m += p.geodesic_length_m;
       tasks += int(p.tasks.size());
     }
     out.Diagnostic("views", double(result.extracted_views));  // as the baselines count them
@@ -105,6 +108,7 @@ class OmtPlanner : public vp::Planner {
     out.Diagnostic("assignment_energy", result.assignment.cost);
     out.Diagnostic("assignment_iterations", result.assignment.iterations);
     out.Diagnostic("path_length_m", length_m);
+    out.Diagnostic("geodesic_length_m", geodesic_length_m);  // the same paths before eq. 5
     out.Diagnostic("terminated", result.terminated ? 1.0 : 0.0);
     out.Diagnostic("anchored_robots", result.anchored_robots);
   }

@@ -25,15 +25,18 @@ T Eta(const Field& field, const RasterGeometry& g, const T& x, const T& y) {
   return eta;
 }
 
+template <typename T>
+T Clamp(const T& v, double lo, double hi) {
+  return v < T(lo) ? T(lo) : (v > T(hi) ? T(hi) : v);
+}
+
 struct SegmentTerm {
-  SegmentTerm(const Field* field, const RasterGeometry* g, double floor)
-      : field(field), g(g), floor(floor) {}
+  SegmentTerm(const Field* field, const RasterGeometry* g, double floor, double cap)
+      : field(field), g(g), floor(floor), cap(cap) {}
   template <typename T>
   bool operator()(const T* a, const T* b, T* residual) const {
-    T ea = Eta(*field, *g, a[0], a[1]);
-    T eb = Eta(*field, *g, b[0], b[1]);
-    if (ea < T(floor)) ea = T(floor);
-    if (eb < T(floor)) eb = T(floor);
+    const T ea = Clamp(Eta(*field, *g, a[0], a[1]), floor, cap);
+    const T eb = Clamp(Eta(*field, *g, b[0], b[1]), floor, cap);
     const T w = ceres::sqrt(T(2.0) / (ea + eb));
     residual[0] = w * (a[0] - b[0]);
     residual[1] = w * (a[1] - b[1]);
@@ -42,6 +45,7 @@ struct SegmentTerm {
   const Field* field;
   const RasterGeometry* g;
   double floor;
+  double cap;
 };
 
 struct AnchorTerm {
@@ -125,8 +129,10 @@ double Eq5Energy(const ClearanceRaster& clearance, const std::vector<PathPoint>&
                  const std::vector<PathPoint>& original, const SmoothingParams& params) {
   double e = 0.0;
   for (std::size_t i = 1; i < points.size(); ++i) {
-    const double ea = std::max(params.eta_floor_m, ClearanceBilinear(clearance, points[i - 1].p_m));
-    const double eb = std::max(params.eta_floor_m, ClearanceBilinear(clearance, points[i].p_m));
+    const double ea = Clamp(ClearanceBilinear(clearance, points[i - 1].p_m), params.eta_floor_m,
+                            params.eta_cap_m);
+    const double eb =
+        Clamp(ClearanceBilinear(clearance, points[i].p_m), params.eta_floor_m, params.eta_cap_m);
     e += 2.0 / (ea + eb) * (points[i].p_m - points[i - 1].p_m).squaredNorm();
   }
   for (std::size_t i = 0; i < points.size() && i < original.size(); ++i)
@@ -151,7 +157,7 @@ Status SmoothPath(const ClearanceRaster& clearance, const SmoothingParams& param
   ceres::Problem problem(problem_options);
   for (std::size_t i = 1; i < x.size(); ++i) {
     problem.AddResidualBlock(new ceres::AutoDiffCostFunction<SegmentTerm, 2, 2, 2>(
-                                 new SegmentTerm(&field, &g, params.eta_floor_m)),
+                                 new SegmentTerm(&field, &g, params.eta_floor_m, params.eta_cap_m)),
                              nullptr, x[i - 1].data(), x[i].data());
   }
   const double sqrt_lambda = std::sqrt(params.lambda);

@@ -1,6 +1,8 @@
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
+#include <utility>
 
 #include "plugins/omt/raster_ops.h"
 #include "plugins/omt/smoothing.h"
@@ -81,6 +83,37 @@ TEST(OmtSmoothing, Eq5ReducesCurvatureAndEnergyAndKeepsClearance) {
     if (after[i].task >= 0) {
       EXPECT_LE((after[i].p_m - before[i].p_m).norm(), kMaxTaskShift_m);
     }
+}
+
+TEST(OmtSmoothing, TruncatedEtaLeavesAStraightPathAcrossAnOpenRoomStraight) {
+  // A straight leg 1 m off the wall of an empty 8 × 4 m room: η is 0.95 m along it and grows to
+  // 1.95 m at the room's middle. Eq. 5's 1/η weight pulls the samples towards the middle; with η
+  // truncated at 0.5 m every weight is the same and the straight line is the optimum.
+  OccupancyRaster raster = MakeRaster(8.0, 4.0, 0.05, Cell::kFree);
+  FrameRect(&raster, 0.0, 0.0, 8.0, 4.0);
+  const ClearanceRaster clearance = ComputeClearance(raster);
+  const std::vector<PathPoint> before = SamplePolyline({{1.0, 1.0}, {7.0, 1.0}}, {{1, 0}}, 0.2);
+  SmoothingParams params;
+  params.min_clearance_m = kRobotRadius;
+  ASSERT_LT(params.eta_cap_m, 0.9);
+  auto smoothed = [&](double eta_cap_m) {
+    std::vector<PathPoint> pts = before;
+    SmoothingParams p = params;
+    p.eta_cap_m = eta_cap_m;
+    EXPECT_TRUE(SmoothPath(clearance, p, &pts).ok());
+    double off_line_m = 0.0;
+    for (const PathPoint& q : pts) off_line_m = std::max(off_line_m, std::abs(q.p_m.y() - 1.0));
+    return std::make_pair(PolylineLength(pts), off_line_m);
+  };
+  constexpr double kStraight_m = 1e-3;
+  const auto [capped_len, capped_off] = smoothed(params.eta_cap_m);
+  EXPECT_LT(capped_off, kStraight_m);
+  EXPECT_LE(capped_len, 6.0 + kStraight_m);  // (the soft λ anchor lets the end creep closer)
+  // Untruncated (the paper's η), the same leg bows almost to the middle (0.99 m) and is 8 %
+  // longer.
+  const auto [full_len, full_off] = smoothed(1e9);
+  EXPECT_GT(full_off, 0.5);
+  EXPECT_GT(full_len, 1.05 * 6.0);
 }
 
 TEST(OmtSmoothing, UTurnAroundAThinWallDoesNotCutThroughIt) {
