@@ -4,6 +4,7 @@
 #include <ceres/cubic_interpolation.h>
 
 #include <algorithm>
+#include <cassert>
 #include <cmath>
 #include <memory>
 
@@ -25,18 +26,13 @@ T Eta(const Field& field, const RasterGeometry& g, const T& x, const T& y) {
   return eta;
 }
 
-template <typename T>
-T Clamp(const T& v, double lo, double hi) {
-  return v < T(lo) ? T(lo) : (v > T(hi) ? T(hi) : v);
-}
-
 struct SegmentTerm {
   SegmentTerm(const Field* field, const RasterGeometry* g, double floor, double cap)
       : field(field), g(g), floor(floor), cap(cap) {}
   template <typename T>
   bool operator()(const T* a, const T* b, T* residual) const {
-    const T ea = Clamp(Eta(*field, *g, a[0], a[1]), floor, cap);
-    const T eb = Clamp(Eta(*field, *g, b[0], b[1]), floor, cap);
+    const T ea = std::clamp(Eta(*field, *g, a[0], a[1]), T(floor), T(cap));
+    const T eb = std::clamp(Eta(*field, *g, b[0], b[1]), T(floor), T(cap));
     const T w = ceres::sqrt(T(2.0) / (ea + eb));
     residual[0] = w * (a[0] - b[0]);
     residual[1] = w * (a[1] - b[1]);
@@ -127,12 +123,13 @@ std::vector<PathPoint> SamplePolyline(const std::vector<Eigen::Vector2d>& polyli
 
 double Eq5Energy(const ClearanceRaster& clearance, const std::vector<PathPoint>& points,
                  const std::vector<PathPoint>& original, const SmoothingParams& params) {
+  assert(params.eta_floor_m <= params.eta_cap_m);
   double e = 0.0;
   for (std::size_t i = 1; i < points.size(); ++i) {
-    const double ea = Clamp(ClearanceBilinear(clearance, points[i - 1].p_m), params.eta_floor_m,
-                            params.eta_cap_m);
-    const double eb =
-        Clamp(ClearanceBilinear(clearance, points[i].p_m), params.eta_floor_m, params.eta_cap_m);
+    const double ea = std::clamp(ClearanceBilinear(clearance, points[i - 1].p_m),
+                                 params.eta_floor_m, params.eta_cap_m);
+    const double eb = std::clamp(ClearanceBilinear(clearance, points[i].p_m), params.eta_floor_m,
+                                 params.eta_cap_m);
     e += 2.0 / (ea + eb) * (points[i].p_m - points[i - 1].p_m).squaredNorm();
   }
   for (std::size_t i = 0; i < points.size() && i < original.size(); ++i)
@@ -142,6 +139,7 @@ double Eq5Energy(const ClearanceRaster& clearance, const std::vector<PathPoint>&
 
 Status SmoothPath(const ClearanceRaster& clearance, const SmoothingParams& params,
                   std::vector<PathPoint>* points) {
+  assert(params.eta_floor_m <= params.eta_cap_m);
   if (points->size() < 3) return Status::Ok();
   const RasterGeometry& g = clearance.geometry;
   if (g.NumCells() == 0) return Status::Error(Status::Code::kInvalidInput, "empty clearance");

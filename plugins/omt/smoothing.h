@@ -23,7 +23,7 @@ struct SmoothingParams {
   // Our choice: η is truncated here. Past it a point is clear of everything, and the full
   // 1/η weight would bow paths towards the middle of every room they cross (over the suite's
   // runs, planned paths 2.5 % (3 robots) / 3.0 % (6) longer than the geodesics they smooth;
-  // 0.1 % / 0.3 % truncated).
+  // 0.1 % / 0.3 % truncated). At least eta_floor_m.
   double eta_cap_m = 0.5;
   // Our addition to eq. 5 (the paper relies on the 1/η barrier alone, which only sees the
   // samples and lets them jump thin walls): a hinge penalty weight · max(0, min_clearance − η)
