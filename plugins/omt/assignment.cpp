@@ -204,6 +204,31 @@ std::vector<double> RobotCapacities(int num_tasks, const std::vector<double>& sp
   return caps;
 }
 
+std::vector<double> ReachCapacities(const AssignmentProblem& p,
+                                    const std::vector<double>& speeds_mps,
+                                    const std::vector<double>& reach_m) {
+  const int R = p.num_robots;
+  std::vector<double> caps(static_cast<std::size_t>(R), 0.0);
+  if (R <= 0 || p.num_tasks <= 0 || speeds_mps.size() != caps.size() ||
+      reach_m.size() != caps.size())
+    return caps;
+  std::vector<double> nearest(caps.size(), std::numeric_limits<double>::infinity());
+  for (int r = 0; r < R; ++r)
+    for (int k = 0; k < p.num_tasks; ++k) nearest[r] = std::min(nearest[r], p.robot_task(r, k));
+  const double closest = *std::min_element(nearest.begin(), nearest.end());
+  std::vector<int> near;
+  std::vector<double> near_speeds;
+  for (int r = 0; r < R; ++r) {
+    if (nearest[r] <= closest + reach_m[r]) {
+      near.push_back(r);
+      near_speeds.push_back(speeds_mps[r]);
+    }
+  }
+  const std::vector<double> shared = RobotCapacities(p.num_tasks, near_speeds);
+  for (std::size_t i = 0; i < near.size(); ++i) caps[near[i]] = shared[i];
+  return caps;
+}
+
 double Eq4Cost(const AssignmentProblem& p, const std::vector<int>& task_robot) {
   std::vector<std::vector<int>> members(p.num_robots);
   for (int k = 0; k < p.num_tasks; ++k)
@@ -319,7 +344,8 @@ Assignment AssignTasks(const AssignmentProblem& p, const AssignmentParams& param
   return out;
 }
 
-void HandOutUnassigned(const AssignmentProblem& problem, double unreachable_m, Assignment* a) {
+void HandOutUnassigned(const AssignmentProblem& problem, double unreachable_m, Assignment* a,
+                       const std::vector<double>& reach_m) {
   std::vector<int> tasks_of(static_cast<std::size_t>(problem.num_robots), 0);
   for (int r : a->task_robot)
     if (r >= 0) ++tasks_of[static_cast<std::size_t>(r)];
@@ -330,6 +356,12 @@ void HandOutUnassigned(const AssignmentProblem& problem, double unreachable_m, A
     double best_m = unreachable_m;  // unreachable tasks are not handed out
     for (int k = 0; k < problem.num_tasks; ++k) {
       if (a->task_robot[static_cast<std::size_t>(k)] >= 0) continue;
+      if (!reach_m.empty()) {
+        double other_m = unreachable_m;
+        for (int q = 0; q < problem.num_robots; ++q)
+          if (q != r) other_m = std::min(other_m, problem.robot_task(q, k));
+        if (problem.robot_task(r, k) > other_m + reach_m[static_cast<std::size_t>(r)]) continue;
+      }
       if (problem.robot_task(r, k) < best_m) {
         best_m = problem.robot_task(r, k);
         best_cluster = a->task_cluster[static_cast<std::size_t>(k)];
@@ -344,6 +376,52 @@ void HandOutUnassigned(const AssignmentProblem& problem, double unreachable_m, A
     changed = true;
   }
   if (changed) a->cost = Eq4Cost(problem, a->task_robot);
+}
+
+void BalanceLoads(const AssignmentProblem& p, const std::vector<double>& driven_m,
+                  double tolerance_m, Assignment* a) {
+  const int R = p.num_robots;
+  if (static_cast<int>(driven_m.size()) != R) return;
+  std::vector<std::vector<int>> members(static_cast<std::size_t>(R));
+  for (int k = 0; k < p.num_tasks; ++k)
+    if (a->task_robot[static_cast<std::size_t>(k)] >= 0)
+      members[static_cast<std::size_t>(a->task_robot[static_cast<std::size_t>(k)])].push_back(k);
+  auto load = [&](int r, const std::vector<int>& m) {
+    int medoid = -1;
+    RobotClusterCost(p, r, m, &medoid);
+    return driven_m[static_cast<std::size_t>(r)] + (m.empty() ? 0.0 : p.robot_task(r, medoid));
+  };
+  auto cost = [&](int r, const std::vector<int>& m) {
+    return RobotClusterCost(p, r, m, nullptr) +
+           CapacityTerm(static_cast<double>(m.size()), p.capacity[static_cast<std::size_t>(r)]);
+  };
+  bool changed = false;
+  bool improved = true;
+  for (int pass = 0; improved && pass < 10; ++pass) {
+    improved = false;
+    for (int x = 0; x < R; ++x) {
+      for (int y = x + 1; y < R; ++y) {
+        std::vector<int>& mx = members[static_cast<std::size_t>(x)];
+        std::vector<int>& my = members[static_cast<std::size_t>(y)];
+        if (mx.empty() && my.empty()) continue;
+        if (cost(x, my) + cost(y, mx) > cost(x, mx) + cost(y, my) + tolerance_m) continue;
+        if (std::max(load(x, my), load(y, mx)) >=
+            std::max(load(x, mx), load(y, my)) - kMinLoadGainM)
+          continue;
+        std::swap(mx, my);
+        improved = changed = true;
+      }
+    }
+  }
+  if (!changed) return;
+  for (int r = 0; r < R; ++r)
+    for (int k : members[static_cast<std::size_t>(r)])
+      a->task_robot[static_cast<std::size_t>(k)] = r;
+  // A cluster goes with its tasks.
+  for (std::size_t k = 0; k < a->task_robot.size(); ++k)
+    if (a->task_robot[k] >= 0 && a->task_cluster[k] >= 0)
+      a->cluster_robot[static_cast<std::size_t>(a->task_cluster[k])] = a->task_robot[k];
+  a->cost = Eq4Cost(p, a->task_robot);
 }
 
 Assignment BruteForceAssignment(const AssignmentProblem& p, long max_labellings) {

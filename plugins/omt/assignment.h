@@ -23,6 +23,15 @@ struct AssignmentProblem {
 // C_r = K / R · v_r / v_max (§3.4).
 std::vector<double> RobotCapacities(int num_tasks, const std::vector<double>& speeds_mps);
 
+// §3.4's C_r shared only among the robots that can start on the work soon: a robot whose
+// nearest task lies more than reach_m[r] beyond the nearest robot's gets C_r = 0, the others
+// split K by RobotCapacities. §5.5: with more robots than the work needs, "the extra robots do
+// not receive any task but stay still"; with K / R for everyone, eq. 4's capacity term instead
+// pulls robots across the scene to tasks others stand next to.
+std::vector<double> ReachCapacities(const AssignmentProblem& problem,
+                                    const std::vector<double>& speeds_mps,
+                                    const std::vector<double>& reach_m);
+
 struct AssignmentParams {
   bool refine = true;    // clustering refinement; off = NoRefine ablation (K = R clusters)
   double delta_m = 1.0;  // a task farther than δ from its cluster centre seeds a new cluster
@@ -45,7 +54,19 @@ struct Assignment {
 // Robots `a` leaves without a task (in index order) each take the unassigned cluster whose
 // nearest task is nearest to them, of those nearer than unreachable_m: a robot does not stand
 // still while work waits. Clusters stay whole (the refinement made them compact).
-void HandOutUnassigned(const AssignmentProblem& problem, double unreachable_m, Assignment* a);
+// With reach_m (one per robot), a robot skips tasks another robot is more than reach_m[r] nearer
+// to: that one takes them when it is free.
+void HandOutUnassigned(const AssignmentProblem& problem, double unreachable_m, Assignment* a,
+                       const std::vector<double>& reach_m = {});
+
+// Eq. 4 balances task counts, not distances: two robots behind the same work pay the same
+// Σ distance whichever of them takes the far cluster. Exchanges the task sets of two robots when
+// eq. 4 (their two robot terms) grows by at most tolerance_m and the larger of their loads —
+// driven_m (distance so far) plus the distance to the medoid — shrinks by more than
+// kMinLoadGainM. Load balance is the paper's COV of distance per robot (§5.1).
+inline constexpr double kMinLoadGainM = 0.1;
+void BalanceLoads(const AssignmentProblem& problem, const std::vector<double>& driven_m,
+                  double tolerance_m, Assignment* a);
 
 // Eq. 4 for a labelling (unassigned tasks, -1, do not enter), each ω_r the best medoid.
 double Eq4Cost(const AssignmentProblem& problem, const std::vector<int>& task_robot);

@@ -228,11 +228,23 @@ Status PlanOmt(const OccupancyRaster& raster, const ClearanceRaster* clearance_i
     for (int k = 0; k < K; ++k) problem.robot_task(r, k) = finite(dist(r, R + k));
   std::vector<double> speeds;
   for (const RobotState& r : robots) speeds.push_back(r.speed_mps);
-  problem.capacity = RobotCapacities(K, speeds);
+  std::vector<double> reach_m;  // empty: every robot shares the work (§3.4)
+  if (options.reach_horizon_s > 0.0) {
+    for (double v : speeds) reach_m.push_back(v * options.reach_horizon_s);
+    problem.capacity = ReachCapacities(problem, speeds, reach_m);
+  } else {
+    problem.capacity = RobotCapacities(K, speeds);
+  }
   AssignmentParams assignment_params = options.assignment;
   assignment_params.refine = options.refine;
   result->assignment = AssignTasks(problem, assignment_params);
-  if (options.hand_out_unassigned) HandOutUnassigned(problem, unreachable, &result->assignment);
+  if (options.hand_out_unassigned)
+    HandOutUnassigned(problem, unreachable, &result->assignment, reach_m);
+  if (options.balance_tolerance_m > 0.0) {
+    std::vector<double> driven_m;
+    for (const RobotState& r : robots) driven_m.push_back(r.driven_m);
+    BalanceLoads(problem, driven_m, options.balance_tolerance_m, &result->assignment);
+  }
 
   // Per robot: open TSP robot → farthest task, geodesic polyline, eq. 5, camera yaw.
   std::vector<double> task_yaw(static_cast<std::size_t>(K));

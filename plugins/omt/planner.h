@@ -19,6 +19,7 @@ struct RobotState {
   Eigen::Vector2d position_m = Eigen::Vector2d::Zero();
   double yaw_rad = 0.0;    // current camera yaw
   double speed_mps = 0.3;  // §4
+  double driven_m = 0.0;   // distance driven so far (load balance, BalanceLoads)
 };
 
 struct PlannerOptions {
@@ -45,6 +46,12 @@ struct PlannerOptions {
   bool assign_unimportant_views = false;
   // A robot the assignment leaves without a task takes the nearest cluster it left unassigned.
   bool hand_out_unassigned = true;
+  // A robot more than reach_horizon_s of driving farther from the work than the nearest robot
+  // gets no capacity and no handed-out cluster this pass: it stays still (ReachCapacities).
+  // 0: C_r = K / R for every robot (§3.4).
+  double reach_horizon_s = 15.0;
+  // Task-set exchanges for load balance (BalanceLoads) that may cost eq. 4 this much; 0: none.
+  double balance_tolerance_m = 1.0;
   int num_threads =
       2;  // geodesics and per-robot paths run in parallel; results do not depend on it
 };

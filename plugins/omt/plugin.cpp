@@ -17,6 +17,29 @@ namespace {
 constexpr uint32_t kViewColor = 0xffa000ffu;
 constexpr uint32_t kPathColor = 0x00c0ffffu;
 
+// Distance each robot has driven, summed over straight moves between plan calls: the host does
+// not report it, and what a robot drives between two calls (at most one planning interval) is
+// mostly straight.
+class DrivenDistance {
+ public:
+  void Update(std::vector<omt::RobotState>* states) {
+    if (last_m_.size() != states->size()) {  // first call
+      last_m_.clear();
+      for (const omt::RobotState& s : *states) last_m_.push_back(s.position_m);
+      driven_m_.assign(states->size(), 0.0);
+    }
+    for (size_t r = 0; r < states->size(); ++r) {
+      driven_m_[r] += ((*states)[r].position_m - last_m_[r]).norm();
+      last_m_[r] = (*states)[r].position_m;
+      (*states)[r].driven_m = driven_m_[r];
+    }
+  }
+
+ private:
+  std::vector<Eigen::Vector2d> last_m_;
+  std::vector<double> driven_m_;
+};
+
 class OmtPlanner : public vp::Planner {
  public:
   explicit OmtPlanner(const vp::Config& config) {
@@ -31,6 +54,8 @@ class OmtPlanner : public vp::Planner {
     o.hand_out_unassigned = json.Flag("hand_out_unassigned", o.hand_out_unassigned);
     o.assignment.delta_m = json.Number("delta_m", o.assignment.delta_m, 0.0, 1e3);
     o.smoothing.eta_cap_m = json.Number("eta_cap_m", o.smoothing.eta_cap_m, 0.05, 1e9);
+    o.reach_horizon_s = json.Number("reach_horizon_s", o.reach_horizon_s, 0.0, 1e6);
+    o.balance_tolerance_m = json.Number("balance_tolerance_m", o.balance_tolerance_m, 0.0, 1e6);
     json.RejectUnknownKeys();
   }
 
@@ -42,6 +67,7 @@ class OmtPlanner : public vp::Planner {
       in = ReadWorld(world, options_);
     }
     if (in.robots.empty()) return;  // nobody to plan for; not "done" either
+    driven_.Update(&in.states);
     const omt::PlannerOptions pass = PassOptions(options_, in);
     settled_.Apply(world, pass, &in);
     out.Diagnostic("settled_cells", double(settled_.size()));
@@ -165,7 +191,8 @@ class OmtPlanner : public vp::Planner {
   }
 
   CommonOptions options_;
-  SettledCells settled_;  // cells looked at in vain, across calls
+  DrivenDistance driven_;  // across calls, for load balance
+  SettledCells settled_;   // cells looked at in vain, across calls
 };
 
 }  // namespace

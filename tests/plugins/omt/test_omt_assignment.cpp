@@ -160,6 +160,70 @@ TEST(OmtAssignment, RobotsWithoutTasksTakeTheNearestUnassignedCluster) {
   EXPECT_EQ(a.task_robot, before.task_robot);
 }
 
+TEST(OmtAssignment, RobotsFarBehindTheWorkGetNoCapacity) {
+  // Robots 0 and 1 stand by the tasks; robot 2 is 20 m away, robot 3 just within 3 m (the reach)
+  // beyond the nearest robot's distance.
+  const std::vector<Eigen::Vector2d> robots{{0.0, 0.0}, {1.0, 0.0}, {20.0, 0.0}, {-3.4, 0.0}};
+  const std::vector<Eigen::Vector2d> tasks{{0.0, 0.5}, {0.5, 0.5}, {1.0, 0.5},
+                                           {0.2, 0.8}, {0.8, 0.8}, {0.5, 1.0}};
+  const AssignmentProblem p = EuclideanProblem(robots, tasks);
+  const std::vector<double> speeds(4, 0.3);
+  const std::vector<double> caps = ReachCapacities(p, speeds, std::vector<double>(4, 3.0));
+  // Robot 3's nearest task is 3.44 m away, the nearest robot's 0.5 m: 2.94 m beyond, within reach.
+  EXPECT_EQ(caps, (std::vector<double>{2.0, 2.0, 0.0, 2.0}));
+  // A long enough reach gives back §3.4's K / R for everyone.
+  EXPECT_EQ(ReachCapacities(p, speeds, std::vector<double>(4, 100.0)), RobotCapacities(6, speeds));
+}
+
+TEST(OmtAssignment, WithAReachIdleRobotsLeaveToNearerRobotsWhatTheyAreFarFrom) {
+  // Robot 0 holds a cluster next to the unassigned pair (tasks 2, 3); idle robot 1 is 12 m away.
+  const std::vector<Eigen::Vector2d> robots{{0.0, 0.0}, {12.0, 0.0}};
+  const std::vector<Eigen::Vector2d> tasks{{0.0, 1.0}, {0.0, 1.2}, {0.0, -1.0}, {0.0, -1.3}};
+  const AssignmentProblem p = EuclideanProblem(robots, tasks);
+  Assignment a;
+  a.task_robot = {0, 0, -1, -1};
+  a.task_cluster = {0, 0, 2, 2};
+  a.cluster_robot = {0, 1, -1};
+  Assignment with_reach = a;
+  HandOutUnassigned(p, 1e6, &with_reach, {7.5, 7.5});
+  EXPECT_EQ(with_reach.task_robot, a.task_robot);  // robot 1 stays still
+  HandOutUnassigned(p, 1e6, &a);
+  EXPECT_EQ(a.task_robot, (std::vector<int>{0, 0, 1, 1}));  // without it, robot 1 drives 12 m
+}
+
+TEST(OmtAssignment, LoadBalanceGivesTheFarClusterToTheRobotThatDroveLess) {
+  // Two robots in a row behind two clusters on the same line: Σ distance is the same whichever
+  // robot takes the far cluster, so eq. 4 does not care; the distance driven so far decides.
+  const std::vector<Eigen::Vector2d> robots{{0.0, 0.0}, {1.0, 0.0}};
+  const std::vector<Eigen::Vector2d> tasks{{5.0, 0.0}, {5.0, 0.2}, {10.0, 0.0}, {10.0, 0.2}};
+  const AssignmentProblem p = EuclideanProblem(robots, tasks);
+  Assignment a;
+  a.task_robot = {0, 0, 1, 1};  // robot 0 to the near cluster, robot 1 to the far one
+  a.task_cluster = {0, 0, 1, 1};
+  a.cluster_robot = {0, 1};
+  a.cost = Eq4Cost(p, a.task_robot);
+  constexpr double kToleranceM = 1.0;
+  // Equal histories: the split already has the smaller larger load (5 and 9, against 10 and 4).
+  Assignment same = a;
+  BalanceLoads(p, {0.0, 0.0}, kToleranceM, &same);
+  EXPECT_EQ(same.task_robot, a.task_robot);
+  // Robot 1 has driven 10 m: loads 5 and 19 become 10 and 14.
+  Assignment swapped = a;
+  BalanceLoads(p, {0.0, 10.0}, kToleranceM, &swapped);
+  EXPECT_EQ(swapped.task_robot, (std::vector<int>{1, 1, 0, 0}));
+  EXPECT_EQ(swapped.cluster_robot, (std::vector<int>{1, 0}));
+  EXPECT_NEAR(swapped.cost, a.cost, kToleranceM);
+  // An exchange that costs eq. 4 more than the tolerance is not made: robot 1 now stands
+  // 8 m off the line, and the exchange costs 1.86 m more.
+  AssignmentProblem off = EuclideanProblem({{0.0, 0.0}, {1.0, 8.0}}, tasks);
+  Assignment kept = a;
+  kept.cost = Eq4Cost(off, a.task_robot);
+  BalanceLoads(off, {0.0, 10.0}, kToleranceM, &kept);
+  EXPECT_EQ(kept.task_robot, a.task_robot);
+  BalanceLoads(off, {0.0, 10.0}, 10.0, &kept);  // a loose tolerance lets it through
+  EXPECT_EQ(kept.task_robot, (std::vector<int>{1, 1, 0, 0}));
+}
+
 TEST(OmtAssignment, RefinedClustersAreCompact) {
   std::mt19937 rng(7);
   std::uniform_real_distribution<double> coord(0.0, 8.0);
