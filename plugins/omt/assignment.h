@@ -63,7 +63,7 @@ void HandOutUnassigned(const AssignmentProblem& problem, double unreachable_m, A
 // Σ distance whichever of them takes the far cluster. Exchanges the task sets of two robots when
 // eq. 4 (their two robot terms) grows by at most tolerance_m and the larger of their loads —
 // driven_m (distance so far) plus the distance to the medoid — shrinks by more than
-// kMinLoadGainM. Load balance is the paper's COV of distance per robot (§5.1).
+// kMinLoadGainM. Load balance is the paper's COV of distance per robot (§5.2).
 inline constexpr double kMinLoadGainM = 0.1;
 void BalanceLoads(const AssignmentProblem& problem, const std::vector<double>& driven_m,
                   double tolerance_m, Assignment* a);
