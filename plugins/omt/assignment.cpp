@@ -409,6 +409,7 @@ void BalanceLoads(const AssignmentProblem& p, const std::vector<double>& driven_
             std::max(load(x, mx), load(y, my)) - kMinLoadGainM)
           continue;
         std::swap(mx, my);
+        ++a->load_exchanges;
         improved = changed = true;
       }
     }

@@ -48,7 +48,8 @@ struct Assignment {
   std::vector<int> cluster_robot;
   int iterations = 0;
   bool converged = false;
-  double cost = 0.0;  // eq. 4 over robot clusters
+  double cost = 0.0;       // eq. 4 over robot clusters
+  int load_exchanges = 0;  // task-set exchanges BalanceLoads made
 };
 
 // Robots `a` leaves without a task (in index order) each take the unassigned cluster whose

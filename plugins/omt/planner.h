@@ -74,6 +74,7 @@ struct PlanResult {
   // view can be accessible and `terminated` says nothing about the scene (e.g. too little known
   // free space around them).
   int anchored_robots = 0;
+  int robots_held_back = 0;  // robots ReachCapacities gave no capacity (they stay still)
 };
 
 // External geodesics (e.g. the host's distance_matrix / shortest_path queries) to use instead

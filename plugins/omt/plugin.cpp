@@ -133,6 +133,8 @@ class OmtPlanner : public vp::Planner {
     out.Diagnostic("views_unassigned", unassigned);
     out.Diagnostic("assignment_energy", result.assignment.cost);
     out.Diagnostic("assignment_iterations", result.assignment.iterations);
+    out.Diagnostic("robots_held_back", result.robots_held_back);
+    out.Diagnostic("load_exchanges", result.assignment.load_exchanges);
     out.Diagnostic("path_length_m", length_m);
     out.Diagnostic("geodesic_length_m", geodesic_length_m);  // the same paths before eq. 5
     out.Diagnostic("terminated", result.terminated ? 1.0 : 0.0);

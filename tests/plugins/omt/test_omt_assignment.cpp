@@ -207,11 +207,13 @@ TEST(OmtAssignment, LoadBalanceGivesTheFarClusterToTheRobotThatDroveLess) {
   Assignment same = a;
   BalanceLoads(p, {0.0, 0.0}, kToleranceM, &same);
   EXPECT_EQ(same.task_robot, a.task_robot);
+  EXPECT_EQ(same.load_exchanges, 0);
   // Robot 1 has driven 10 m: loads 5 and 19 become 10 and 14.
   Assignment swapped = a;
   BalanceLoads(p, {0.0, 10.0}, kToleranceM, &swapped);
   EXPECT_EQ(swapped.task_robot, (std::vector<int>{1, 1, 0, 0}));
   EXPECT_EQ(swapped.cluster_robot, (std::vector<int>{1, 0}));
+  EXPECT_EQ(swapped.load_exchanges, 1);
   EXPECT_NEAR(swapped.cost, a.cost, kToleranceM);
   // An exchange that costs eq. 4 more than the tolerance is not made: robot 1 now stands
   // 8 m off the line, and the exchange costs 1.86 m more.
