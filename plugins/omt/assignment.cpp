@@ -386,14 +386,18 @@ void BalanceLoads(const AssignmentProblem& p, const std::vector<double>& driven_
   for (int k = 0; k < p.num_tasks; ++k)
     if (a->task_robot[static_cast<std::size_t>(k)] >= 0)
       members[static_cast<std::size_t>(a->task_robot[static_cast<std::size_t>(k)])].push_back(k);
-  auto load = [&](int r, const std::vector<int>& m) {
-    int medoid = -1;
-    RobotClusterCost(p, r, m, &medoid);
-    return driven_m[static_cast<std::size_t>(r)] + (m.empty() ? 0.0 : p.robot_task(r, medoid));
+  // Eq. 4's robot term and the load of robot r holding task set m, from one medoid search.
+  struct Eval {
+    double cost;
+    double load_m;
   };
-  auto cost = [&](int r, const std::vector<int>& m) {
-    return RobotClusterCost(p, r, m, nullptr) +
-           CapacityTerm(static_cast<double>(m.size()), p.capacity[static_cast<std::size_t>(r)]);
+  auto eval = [&](int r, const std::vector<int>& m) {
+    int medoid = -1;
+    const double cluster = RobotClusterCost(p, r, m, &medoid);
+    return Eval{
+        cluster +
+            CapacityTerm(static_cast<double>(m.size()), p.capacity[static_cast<std::size_t>(r)]),
+        driven_m[static_cast<std::size_t>(r)] + (m.empty() ? 0.0 : p.robot_task(r, medoid))};
   };
   bool changed = false;
   bool improved = true;
@@ -404,9 +408,11 @@ void BalanceLoads(const AssignmentProblem& p, const std::vector<double>& driven_
         std::vector<int>& mx = members[static_cast<std::size_t>(x)];
         std::vector<int>& my = members[static_cast<std::size_t>(y)];
         if (mx.empty() && my.empty()) continue;
-        if (cost(x, my) + cost(y, mx) > cost(x, mx) + cost(y, my) + tolerance_m) continue;
-        if (std::max(load(x, my), load(y, mx)) >=
-            std::max(load(x, mx), load(y, my)) - kMinLoadGainM)
+        const Eval own_x = eval(x, mx), own_y = eval(y, my);
+        const Eval new_x = eval(x, my), new_y = eval(y, mx);
+        if (new_x.cost + new_y.cost > own_x.cost + own_y.cost + tolerance_m) continue;
+        if (std::max(new_x.load_m, new_y.load_m) >=
+            std::max(own_x.load_m, own_y.load_m) - kMinLoadGainM)
           continue;
         std::swap(mx, my);
         ++a->load_exchanges;

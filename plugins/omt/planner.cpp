@@ -232,9 +232,8 @@ Status PlanOmt(const OccupancyRaster& raster, const ClearanceRaster* clearance_i
   if (options.reach_horizon_s > 0.0) {
     for (double v : speeds) reach_m.push_back(v * options.reach_horizon_s);
     problem.capacity = ReachCapacities(problem, speeds, reach_m);
-    const std::vector<double> shared = RobotCapacities(K, speeds);
-    for (int r = 0; r < R; ++r)
-      result->robots_held_back += problem.capacity[r] == 0.0 && shared[r] > 0.0;
+    for (int r = 0; K > 0 && r < R; ++r)  // a robot with speed 0 has no capacity anyway
+      result->robots_held_back += problem.capacity[r] == 0.0 && speeds[r] > 0.0;
   } else {
     problem.capacity = RobotCapacities(K, speeds);
   }
