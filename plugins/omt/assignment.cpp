@@ -399,6 +399,8 @@ void BalanceLoads(const AssignmentProblem& p, const std::vector<double>& driven_
             CapacityTerm(static_cast<double>(m.size()), p.capacity[static_cast<std::size_t>(r)]),
         driven_m[static_cast<std::size_t>(r)] + (m.empty() ? 0.0 : p.robot_task(r, medoid))};
   };
+  std::vector<Eval> own;  // each robot with its current task set; updated on exchange
+  for (int r = 0; r < R; ++r) own.push_back(eval(r, members[static_cast<std::size_t>(r)]));
   bool changed = false;
   bool improved = true;
   for (int pass = 0; improved && pass < 10; ++pass) {
@@ -408,13 +410,16 @@ void BalanceLoads(const AssignmentProblem& p, const std::vector<double>& driven_
         std::vector<int>& mx = members[static_cast<std::size_t>(x)];
         std::vector<int>& my = members[static_cast<std::size_t>(y)];
         if (mx.empty() && my.empty()) continue;
-        const Eval own_x = eval(x, mx), own_y = eval(y, my);
+        Eval& own_x = own[static_cast<std::size_t>(x)];
+        Eval& own_y = own[static_cast<std::size_t>(y)];
         const Eval new_x = eval(x, my), new_y = eval(y, mx);
         if (new_x.cost + new_y.cost > own_x.cost + own_y.cost + tolerance_m) continue;
         if (std::max(new_x.load_m, new_y.load_m) >=
             std::max(own_x.load_m, own_y.load_m) - kMinLoadGainM)
           continue;
         std::swap(mx, my);
+        own_x = new_x;
+        own_y = new_y;
         ++a->load_exchanges;
         improved = changed = true;
       }
