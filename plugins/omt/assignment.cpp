@@ -30,6 +30,25 @@ double RobotClusterCost(const AssignmentProblem& p, int robot, const std::vector
 
 double CapacityTerm(double n, double c) { return (n - c) * (n - c); }
 
+// Eq. 4's term of one robot holding `members`: compactness + distance (best medoid) + capacity.
+double RobotTerm(const AssignmentProblem& p, int robot, const std::vector<int>& members,
+                 int* medoid) {
+  return RobotClusterCost(p, robot, members, medoid) +
+         CapacityTerm(static_cast<double>(members.size()),
+                      p.capacity[static_cast<std::size_t>(robot)]);
+}
+
+// Each robot's tasks (ascending) under a labelling; unassigned tasks (-1) are left out.
+std::vector<std::vector<int>> TasksByRobot(const AssignmentProblem& p,
+                                           const std::vector<int>& task_robot) {
+  std::vector<std::vector<int>> members(static_cast<std::size_t>(p.num_robots));
+  for (int k = 0; k < p.num_tasks; ++k) {
+    const int r = task_robot[static_cast<std::size_t>(k)];
+    if (r >= 0) members[static_cast<std::size_t>(r)].push_back(k);
+  }
+  return members;
+}
+
 struct Cluster {
   int robot = -1;   // seeding robot, -1 for a task seed
   int center = -1;  // medoid task; -1 = the robot's own position (before it has tasks)
@@ -108,8 +127,7 @@ void Polish(const AssignmentProblem& p, std::vector<int>* task_robot) {
     std::vector<int> m;
     for (int k = 0; k < K; ++k)
       if (labels[k] == r) m.push_back(k);
-    return RobotClusterCost(p, r, m, nullptr) +
-           CapacityTerm(static_cast<double>(m.size()), p.capacity[r]);
+    return RobotTerm(p, r, m, nullptr);
   };
   std::vector<double> cost(R);
   for (int r = 0; r < R; ++r) cost[r] = robot_cost(r);
@@ -230,14 +248,9 @@ std::vector<double> ReachCapacities(const AssignmentProblem& p,
 }
 
 double Eq4Cost(const AssignmentProblem& p, const std::vector<int>& task_robot) {
-  std::vector<std::vector<int>> members(p.num_robots);
-  for (int k = 0; k < p.num_tasks; ++k)
-    if (task_robot[k] >= 0) members[task_robot[k]].push_back(k);
+  const std::vector<std::vector<int>> members = TasksByRobot(p, task_robot);
   double cost = 0.0;
-  for (int r = 0; r < p.num_robots; ++r) {
-    cost += RobotClusterCost(p, r, members[r], nullptr);
-    cost += CapacityTerm(static_cast<double>(members[r].size()), p.capacity[r]);
-  }
+  for (int r = 0; r < p.num_robots; ++r) cost += RobotTerm(p, r, members[r], nullptr);
   return cost;
 }
 
@@ -382,10 +395,7 @@ void BalanceLoads(const AssignmentProblem& p, const std::vector<double>& driven_
                   double tolerance_m, Assignment* a) {
   const int R = p.num_robots;
   if (static_cast<int>(driven_m.size()) != R) return;
-  std::vector<std::vector<int>> members(static_cast<std::size_t>(R));
-  for (int k = 0; k < p.num_tasks; ++k)
-    if (a->task_robot[static_cast<std::size_t>(k)] >= 0)
-      members[static_cast<std::size_t>(a->task_robot[static_cast<std::size_t>(k)])].push_back(k);
+  std::vector<std::vector<int>> members = TasksByRobot(p, a->task_robot);
   // Eq. 4's robot term and the load of robot r holding task set m, from one medoid search.
   struct Eval {
     double cost;
@@ -393,11 +403,9 @@ void BalanceLoads(const AssignmentProblem& p, const std::vector<double>& driven_
   };
   auto eval = [&](int r, const std::vector<int>& m) {
     int medoid = -1;
-    const double cluster = RobotClusterCost(p, r, m, &medoid);
+    const double cost = RobotTerm(p, r, m, &medoid);
     return Eval{
-        cluster +
-            CapacityTerm(static_cast<double>(m.size()), p.capacity[static_cast<std::size_t>(r)]),
-        driven_m[static_cast<std::size_t>(r)] + (m.empty() ? 0.0 : p.robot_task(r, medoid))};
+        cost, driven_m[static_cast<std::size_t>(r)] + (m.empty() ? 0.0 : p.robot_task(r, medoid))};
   };
   std::vector<Eval> own;  // each robot with its current task set; updated on exchange
   for (int r = 0; r < R; ++r) own.push_back(eval(r, members[static_cast<std::size_t>(r)]));
