@@ -247,6 +247,32 @@ std::vector<double> ReachCapacities(const AssignmentProblem& p,
   return caps;
 }
 
+std::vector<double> TeamCapacities(const AssignmentProblem& p,
+                                   const std::vector<double>& speeds_mps,
+                                   const std::vector<double>& driven_m, double views_per_robot) {
+  std::vector<double> caps = p.capacity;
+  if (!(views_per_robot > 0.0) || p.num_tasks <= 0 || caps.size() != speeds_mps.size() ||
+      caps.size() != driven_m.size())
+    return caps;
+  std::vector<std::pair<double, int>> busy;  // (load, robot) of the robots with capacity
+  for (int r = 0; r < p.num_robots; ++r) {
+    if (!(caps[static_cast<std::size_t>(r)] > 0.0)) continue;
+    double nearest = std::numeric_limits<double>::infinity();
+    for (int k = 0; k < p.num_tasks; ++k) nearest = std::min(nearest, p.robot_task(r, k));
+    busy.emplace_back(driven_m[static_cast<std::size_t>(r)] + nearest, r);
+  }
+  const auto keep = static_cast<std::size_t>(std::ceil(p.num_tasks / views_per_robot));
+  if (busy.size() <= keep) return caps;
+  std::sort(busy.begin(), busy.end());
+  std::vector<double> kept_speeds;
+  for (std::size_t i = 0; i < keep; ++i)
+    kept_speeds.push_back(speeds_mps[static_cast<std::size_t>(busy[i].second)]);
+  const std::vector<double> shared = RobotCapacities(p.num_tasks, kept_speeds);
+  std::fill(caps.begin(), caps.end(), 0.0);
+  for (std::size_t i = 0; i < keep; ++i) caps[static_cast<std::size_t>(busy[i].second)] = shared[i];
+  return caps;
+}
+
 double Eq4Cost(const AssignmentProblem& p, const std::vector<int>& task_robot) {
   const std::vector<std::vector<int>> members = TasksByRobot(p, task_robot);
   double cost = 0.0;

@@ -32,6 +32,15 @@ std::vector<double> ReachCapacities(const AssignmentProblem& problem,
                                     const std::vector<double>& speeds_mps,
                                     const std::vector<double>& reach_m);
 
+// §5.5 also when the views are few for the team: K views keep at most ⌈K / views_per_robot⌉
+// robots busy. Of the robots with capacity in problem.capacity, those with the smallest load —
+// driven_m (distance so far) plus the distance to their nearest task, ties to the lower index —
+// share K by RobotCapacities; the others get C_r = 0 and stay still. Unchanged when
+// views_per_robot <= 0 or no more robots have capacity than that.
+std::vector<double> TeamCapacities(const AssignmentProblem& problem,
+                                   const std::vector<double>& speeds_mps,
+                                   const std::vector<double>& driven_m, double views_per_robot);
+
 struct AssignmentParams {
   bool refine = true;    // clustering refinement; off = NoRefine ablation (K = R clusters)
   double delta_m = 1.0;  // a task farther than δ from its cluster centre seeds a new cluster

@@ -232,19 +232,29 @@ Status PlanOmt(const OccupancyRaster& raster, const ClearanceRaster* clearance_i
   if (options.reach_horizon_s > 0.0) {
     for (double v : speeds) reach_m.push_back(v * options.reach_horizon_s);
     problem.capacity = ReachCapacities(problem, speeds, reach_m);
-    for (int r = 0; K > 0 && r < R; ++r)  // a robot with speed 0 has no capacity anyway
-      result->robots_held_back += problem.capacity[r] == 0.0 && speeds[r] > 0.0;
   } else {
     problem.capacity = RobotCapacities(K, speeds);
   }
+  std::vector<double> driven_m;
+  for (const RobotState& r : robots) driven_m.push_back(r.driven_m);
+  if (options.team_views_per_robot > 0.0) {
+    const std::vector<double> shared = problem.capacity;
+    problem.capacity = TeamCapacities(problem, speeds, driven_m, options.team_views_per_robot);
+    for (int r = 0; r < R; ++r) {
+      if (!(shared[r] > 0.0) || problem.capacity[r] > 0.0) continue;
+      // Held back: a reach of -inf lets HandOutUnassigned give it nothing either.
+      if (reach_m.empty()) reach_m.assign(R, std::numeric_limits<double>::infinity());
+      reach_m[r] = -std::numeric_limits<double>::infinity();
+    }
+  }
+  for (int r = 0; K > 0 && r < R; ++r)  // a robot with speed 0 has no capacity anyway
+    result->robots_held_back += problem.capacity[r] == 0.0 && speeds[r] > 0.0;
   AssignmentParams assignment_params = options.assignment;
   assignment_params.refine = options.refine;
   result->assignment = AssignTasks(problem, assignment_params);
   if (options.hand_out_unassigned)
     HandOutUnassigned(problem, unreachable, &result->assignment, reach_m);
   if (options.balance_tolerance_m > 0.0) {
-    std::vector<double> driven_m;
-    for (const RobotState& r : robots) driven_m.push_back(r.driven_m);
     BalanceLoads(problem, driven_m, options.balance_tolerance_m, &result->assignment);
   }
 

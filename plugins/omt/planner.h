@@ -50,6 +50,9 @@ struct PlannerOptions {
   // gets no capacity and no handed-out cluster this pass: it stays still (ReachCapacities).
   // 0: C_r = K / R for every robot (§3.4).
   double reach_horizon_s = 15.0;
+  // With K views, at most ⌈K / team_views_per_robot⌉ robots get capacity, those with the least
+  // driving behind them and to the work; the others stay still (TeamCapacities). 0: every robot.
+  double team_views_per_robot = 3.0;
   // Task-set exchanges for load balance (BalanceLoads) that may cost eq. 4 this much; 0: none.
   double balance_tolerance_m = 1.0;
   int num_threads =
@@ -74,7 +77,7 @@ struct PlanResult {
   // view can be accessible and `terminated` says nothing about the scene (e.g. too little known
   // free space around them).
   int anchored_robots = 0;
-  int robots_held_back = 0;  // robots ReachCapacities gave no capacity (they stay still)
+  int robots_held_back = 0;  // robots given no capacity (Reach / TeamCapacities): they stay still
 };
 
 // External geodesics (e.g. the host's distance_matrix / shortest_path queries) to use instead

@@ -56,6 +56,7 @@ class OmtPlanner : public vp::Planner {
     o.smoothing.eta_cap_m = json.Number("eta_cap_m", o.smoothing.eta_cap_m, 0.05, 1e9);
     o.reach_horizon_s = json.Number("reach_horizon_s", o.reach_horizon_s, 0.0, 1e6);
     o.balance_tolerance_m = json.Number("balance_tolerance_m", o.balance_tolerance_m, 0.0, 1e6);
+    o.team_views_per_robot = json.Number("team_views_per_robot", o.team_views_per_robot, 0.0, 1e6);
     json.RejectUnknownKeys();
   }
 

@@ -175,6 +175,27 @@ TEST(OmtAssignment, RobotsFarBehindTheWorkGetNoCapacity) {
   EXPECT_EQ(ReachCapacities(p, speeds, std::vector<double>(4, 100.0)), RobotCapacities(6, speeds));
 }
 
+TEST(OmtAssignment, FewViewsKeepOnlyTheLeastLoadedRobotsBusy) {
+  // Five tasks in a row 1 m ahead. Robots 0 and 1 stand 1 m from them, robot 2 2.24 m; robot 0
+  // has driven 10 m, the others nothing; robot 3 had no capacity to begin with (the reach).
+  const std::vector<Eigen::Vector2d> robots{{0.0, 0.0}, {1.0, 0.0}, {-2.0, 0.0}, {2.0, 0.0}};
+  const std::vector<Eigen::Vector2d> tasks{
+      {0.0, 1.0}, {0.5, 1.0}, {1.0, 1.0}, {1.5, 1.0}, {2.0, 1.0}};
+  AssignmentProblem p = EuclideanProblem(robots, tasks);
+  const std::vector<double> speeds(4, 0.3);
+  p.capacity = RobotCapacities(5, std::vector<double>(3, 0.3));
+  p.capacity.push_back(0.0);
+  const std::vector<double> driven{10.0, 0.0, 0.0, 0.0};
+  // 3 views a robot: ⌈5 / 3⌉ = 2 robots, the two least loaded (1 m and 2.24 m against 11 m).
+  EXPECT_EQ(TeamCapacities(p, speeds, driven, 3.0), (std::vector<double>{0.0, 2.5, 2.5, 0.0}));
+  // Enough views for the three with capacity, or no limit: unchanged.
+  EXPECT_EQ(TeamCapacities(p, speeds, driven, 5.0 / 3.0), p.capacity);
+  EXPECT_EQ(TeamCapacities(p, speeds, driven, 0.0), p.capacity);
+  // Equal loads go to the lower index.
+  EXPECT_EQ(TeamCapacities(p, speeds, {0.0, 0.0, 0.0, 0.0}, 5.0),
+            (std::vector<double>{5.0, 0.0, 0.0, 0.0}));
+}
+
 TEST(OmtAssignment, WithAReachIdleRobotsLeaveToNearerRobotsWhatTheyAreFarFrom) {
   // Robot 0 holds a cluster next to the unassigned pair (tasks 2, 3); idle robot 1 is 12 m away.
   const std::vector<Eigen::Vector2d> robots{{0.0, 0.0}, {12.0, 0.0}};

@@ -197,6 +197,34 @@ TEST_F(OmtPlanner, PathOptimisationShortensPaths) {
   EXPECT_LT(l_smooth, l_raw);
 }
 
+TEST_F(OmtPlanner, FewViewsForTheTeamLeaveTheExtraRobotsStill) {
+  // Six robots in the known part, fewer than 3 important views each: ⌈K / 3⌉ robots work.
+  std::vector<RobotState> robots = Robots();
+  for (RobotState r : Robots()) {
+    r.position_m.x() += 0.5;
+    robots.push_back(r);
+  }
+  auto busy = [](const PlanResult& result) {
+    return std::count_if(result.robots.begin(), result.robots.end(),
+                         [](const RobotPlan& plan) { return !plan.tasks.empty(); });
+  };
+  PlannerOptions options;
+  options.reach_horizon_s = 0.0;  // only the team limit holds robots back
+  PlanResult result;
+  ASSERT_TRUE(PlanOmt(raster_, &clearance_, robots, options, &result).ok());
+  const int views = static_cast<int>(result.views.size());
+  ASSERT_GT(views, 0);
+  ASSERT_LT(views, 3 * 6);
+  const int workers = (views + 2) / 3;
+  EXPECT_EQ(result.robots_held_back, 6 - workers);
+  EXPECT_LE(busy(result), workers);
+  // Without the limit every robot has capacity, and more of them drive.
+  options.team_views_per_robot = 0.0;
+  ASSERT_TRUE(PlanOmt(raster_, &clearance_, robots, options, &result).ok());
+  EXPECT_EQ(result.robots_held_back, 0);
+  EXPECT_GT(busy(result), workers);
+}
+
 TEST_F(OmtPlanner, ExternalGeodesicsAreUsedFromTheCallingThread) {
   // Provider: the internal geodesics' stand-in, Euclidean distances and straight segments, in
   // a scene where those are wrong only by going through walls; what matters is that they are
