@@ -35,7 +35,8 @@ std::vector<double> ReachCapacities(const AssignmentProblem& problem,
 // §5.5 also when the views are few for the team: K views keep at most ⌈K / views_per_robot⌉
 // robots busy. Of the robots with capacity in problem.capacity, those with the smallest load —
 // driven_m (distance so far) plus the distance to their nearest task, ties to the lower index —
-// share K by RobotCapacities; the others get C_r = 0 and stay still. Unchanged when
+// share K by RobotCapacities; the others get C_r = 0 and stay still (unless BalanceLoads hands
+// one a task set, which it does only where that lowers the larger load). Unchanged when
 // views_per_robot <= 0 or no more robots have capacity than that.
 std::vector<double> TeamCapacities(const AssignmentProblem& problem,
                                    const std::vector<double>& speeds_mps,
@@ -65,7 +66,7 @@ struct Assignment {
 // nearest task is nearest to them, of those nearer than unreachable_m: a robot does not stand
 // still while work waits. Clusters stay whole (the refinement made them compact).
 // With reach_m (one per robot), a robot skips tasks another robot is more than reach_m[r] nearer
-// to: that one takes them when it is free.
+// to: that one takes them when it is free (-inf: it takes none, +inf: any).
 void HandOutUnassigned(const AssignmentProblem& problem, double unreachable_m, Assignment* a,
                        const std::vector<double>& reach_m = {});
 
