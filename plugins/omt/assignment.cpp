@@ -249,7 +249,8 @@ std::vector<double> ReachCapacities(const AssignmentProblem& p,
 
 std::vector<double> TeamCapacities(const AssignmentProblem& p,
                                    const std::vector<double>& speeds_mps,
-                                   const std::vector<double>& driven_m, double views_per_robot) {
+                                   const std::vector<double>& driven_m, double views_per_robot,
+                                   double driven_weight) {
   std::vector<double> caps = p.capacity;
   if (!(views_per_robot > 0.0) || p.num_tasks <= 0 || caps.size() != speeds_mps.size() ||
       caps.size() != driven_m.size())
@@ -259,7 +260,7 @@ std::vector<double> TeamCapacities(const AssignmentProblem& p,
     if (!(caps[static_cast<std::size_t>(r)] > 0.0)) continue;
     double nearest = std::numeric_limits<double>::infinity();
     for (int k = 0; k < p.num_tasks; ++k) nearest = std::min(nearest, p.robot_task(r, k));
-    busy.emplace_back(driven_m[static_cast<std::size_t>(r)] + nearest, r);
+    busy.emplace_back(driven_weight * driven_m[static_cast<std::size_t>(r)] + nearest, r);
   }
   const auto keep = static_cast<std::size_t>(std::ceil(p.num_tasks / views_per_robot));
   if (busy.size() <= keep) return caps;

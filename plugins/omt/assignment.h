@@ -34,13 +34,14 @@ std::vector<double> ReachCapacities(const AssignmentProblem& problem,
 
 // §5.5 also when the views are few for the team: K views keep at most ⌈K / views_per_robot⌉
 // robots busy. Of the robots with capacity in problem.capacity, those with the smallest load —
-// driven_m (distance so far) plus the distance to their nearest task, ties to the lower index —
-// share K by RobotCapacities; the others get C_r = 0 and stay still (unless BalanceLoads hands
-// one a task set, which it does only where that lowers the larger load). Unchanged when
-// views_per_robot <= 0 or no more robots have capacity than that.
+// driven_weight × driven_m (distance so far) plus the distance to their nearest task, ties to
+// the lower index — share K by RobotCapacities; the others get C_r = 0 and stay still (unless
+// BalanceLoads hands one a task set, which it does only where that lowers the larger load).
+// Unchanged when views_per_robot <= 0 or no more robots have capacity than that.
 std::vector<double> TeamCapacities(const AssignmentProblem& problem,
                                    const std::vector<double>& speeds_mps,
-                                   const std::vector<double>& driven_m, double views_per_robot);
+                                   const std::vector<double>& driven_m, double views_per_robot,
+                                   double driven_weight);
 
 struct AssignmentParams {
   bool refine = true;    // clustering refinement; off = NoRefine ablation (K = R clusters)

@@ -239,7 +239,8 @@ Status PlanOmt(const OccupancyRaster& raster, const ClearanceRaster* clearance_i
   for (const RobotState& r : robots) driven_m.push_back(r.driven_m);
   if (options.team_views_per_robot > 0.0) {
     const std::vector<double> shared = problem.capacity;
-    problem.capacity = TeamCapacities(problem, speeds, driven_m, options.team_views_per_robot);
+    problem.capacity = TeamCapacities(problem, speeds, driven_m, options.team_views_per_robot,
+                                      options.team_driven_weight);
     for (int r = 0; r < R; ++r) {
       if (!(shared[r] > 0.0) || problem.capacity[r] > 0.0) continue;
       // Held back: a reach of -inf lets HandOutUnassigned give it nothing either.

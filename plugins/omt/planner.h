@@ -51,8 +51,10 @@ struct PlannerOptions {
   // 0: C_r = K / R for every robot (§3.4).
   double reach_horizon_s = 15.0;
   // With K views, at most ⌈K / team_views_per_robot⌉ robots get capacity, those with the least
-  // driving behind them and to the work; the others stay still (TeamCapacities). 0: every robot.
+  // team_driven_weight × distance driven + distance to the nearest view; the others stay still
+  // (TeamCapacities). 0: every robot.
   double team_views_per_robot = 3.0;
+  double team_driven_weight = 3.0;
   // Task-set exchanges for load balance (BalanceLoads) that may cost eq. 4 this much; 0: none.
   double balance_tolerance_m = 1.0;
   int num_threads =

@@ -57,6 +57,7 @@ class OmtPlanner : public vp::Planner {
     o.reach_horizon_s = json.Number("reach_horizon_s", o.reach_horizon_s, 0.0, 1e6);
     o.balance_tolerance_m = json.Number("balance_tolerance_m", o.balance_tolerance_m, 0.0, 1e6);
     o.team_views_per_robot = json.Number("team_views_per_robot", o.team_views_per_robot, 0.0, 1e6);
+    o.team_driven_weight = json.Number("team_driven_weight", o.team_driven_weight, 0.0, 1e6);
     json.RejectUnknownKeys();
   }
 

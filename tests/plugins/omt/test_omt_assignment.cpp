@@ -187,12 +187,19 @@ TEST(OmtAssignment, FewViewsKeepOnlyTheLeastLoadedRobotsBusy) {
   p.capacity.push_back(0.0);
   const std::vector<double> driven{10.0, 0.0, 0.0, 0.0};
   // 3 views a robot: ⌈5 / 3⌉ = 2 robots, the two least loaded (1 m and 2.24 m against 11 m).
-  EXPECT_EQ(TeamCapacities(p, speeds, driven, 3.0), (std::vector<double>{0.0, 2.5, 2.5, 0.0}));
+  EXPECT_EQ(TeamCapacities(p, speeds, driven, 3.0, 1.0), (std::vector<double>{0.0, 2.5, 2.5, 0.0}));
   // Enough views for the three with capacity, or no limit: unchanged.
-  EXPECT_EQ(TeamCapacities(p, speeds, driven, 5.0 / 3.0), p.capacity);
-  EXPECT_EQ(TeamCapacities(p, speeds, driven, 0.0), p.capacity);
+  EXPECT_EQ(TeamCapacities(p, speeds, driven, 5.0 / 3.0, 1.0), p.capacity);
+  EXPECT_EQ(TeamCapacities(p, speeds, driven, 0.0, 1.0), p.capacity);
+  // The distance driven counts driven_weight times: robot 1, 1 m driven and 1 m from the work,
+  // goes before robot 2 (2.24 m away, nothing driven) at weight 1, after it at weight 3.
+  const std::vector<double> one_metre{10.0, 1.0, 0.0, 0.0};
+  EXPECT_EQ(TeamCapacities(p, speeds, one_metre, 5.0, 1.0),
+            (std::vector<double>{0.0, 5.0, 0.0, 0.0}));
+  EXPECT_EQ(TeamCapacities(p, speeds, one_metre, 5.0, 3.0),
+            (std::vector<double>{0.0, 0.0, 5.0, 0.0}));
   // Equal loads go to the lower index.
-  EXPECT_EQ(TeamCapacities(p, speeds, {0.0, 0.0, 0.0, 0.0}, 5.0),
+  EXPECT_EQ(TeamCapacities(p, speeds, {0.0, 0.0, 0.0, 0.0}, 5.0, 1.0),
             (std::vector<double>{5.0, 0.0, 0.0, 0.0}));
 }
 
