@@ -222,56 +222,63 @@ std::vector<double> RobotCapacities(int num_tasks, const std::vector<double>& sp
   return caps;
 }
 
+namespace {
+
+double NearestTaskM(const AssignmentProblem& p, int robot) {
+  double nearest = std::numeric_limits<double>::infinity();
+  for (int k = 0; k < p.num_tasks; ++k) nearest = std::min(nearest, p.robot_task(robot, k));
+  return nearest;
+}
+
+// C_r = 0 except for `sharing` (robot indices), which split the tasks by RobotCapacities.
+std::vector<double> SharedAmong(const AssignmentProblem& p, const std::vector<double>& speeds_mps,
+                                const std::vector<int>& sharing) {
+  std::vector<double> speeds;
+  for (int r : sharing) speeds.push_back(speeds_mps[static_cast<std::size_t>(r)]);
+  const std::vector<double> shared = RobotCapacities(p.num_tasks, speeds);
+  std::vector<double> caps(static_cast<std::size_t>(p.num_robots), 0.0);
+  for (std::size_t i = 0; i < sharing.size(); ++i)
+    caps[static_cast<std::size_t>(sharing[i])] = shared[i];
+  return caps;
+}
+
+}  // namespace
+
 std::vector<double> ReachCapacities(const AssignmentProblem& p,
                                     const std::vector<double>& speeds_mps,
                                     const std::vector<double>& reach_m) {
   const int R = p.num_robots;
-  std::vector<double> caps(static_cast<std::size_t>(R), 0.0);
-  if (R <= 0 || p.num_tasks <= 0 || speeds_mps.size() != caps.size() ||
-      reach_m.size() != caps.size())
-    return caps;
-  std::vector<double> nearest(caps.size(), std::numeric_limits<double>::infinity());
-  for (int r = 0; r < R; ++r)
-    for (int k = 0; k < p.num_tasks; ++k) nearest[r] = std::min(nearest[r], p.robot_task(r, k));
+  if (R <= 0 || p.num_tasks <= 0 || speeds_mps.size() != static_cast<std::size_t>(R) ||
+      reach_m.size() != static_cast<std::size_t>(R))
+    return std::vector<double>(static_cast<std::size_t>(std::max(R, 0)), 0.0);
+  std::vector<double> nearest;
+  for (int r = 0; r < R; ++r) nearest.push_back(NearestTaskM(p, r));
   const double closest = *std::min_element(nearest.begin(), nearest.end());
   std::vector<int> near;
-  std::vector<double> near_speeds;
-  for (int r = 0; r < R; ++r) {
-    if (nearest[r] <= closest + reach_m[r]) {
-      near.push_back(r);
-      near_speeds.push_back(speeds_mps[r]);
-    }
-  }
-  const std::vector<double> shared = RobotCapacities(p.num_tasks, near_speeds);
-  for (std::size_t i = 0; i < near.size(); ++i) caps[near[i]] = shared[i];
-  return caps;
+  for (int r = 0; r < R; ++r)
+    if (nearest[r] <= closest + reach_m[r]) near.push_back(r);
+  return SharedAmong(p, speeds_mps, near);
 }
 
 std::vector<double> TeamCapacities(const AssignmentProblem& p,
                                    const std::vector<double>& speeds_mps,
                                    const std::vector<double>& driven_m, double views_per_robot,
                                    double driven_weight) {
-  std::vector<double> caps = p.capacity;
-  if (!(views_per_robot > 0.0) || p.num_tasks <= 0 || caps.size() != speeds_mps.size() ||
-      caps.size() != driven_m.size())
-    return caps;
+  if (!(views_per_robot > 0.0) || p.num_tasks <= 0 || p.capacity.size() != speeds_mps.size() ||
+      p.capacity.size() != driven_m.size())
+    return p.capacity;
   std::vector<std::pair<double, int>> busy;  // (load, robot) of the robots with capacity
   for (int r = 0; r < p.num_robots; ++r) {
-    if (!(caps[static_cast<std::size_t>(r)] > 0.0)) continue;
-    double nearest = std::numeric_limits<double>::infinity();
-    for (int k = 0; k < p.num_tasks; ++k) nearest = std::min(nearest, p.robot_task(r, k));
-    busy.emplace_back(driven_weight * driven_m[static_cast<std::size_t>(r)] + nearest, r);
+    if (!(p.capacity[static_cast<std::size_t>(r)] > 0.0)) continue;
+    busy.emplace_back(driven_weight * driven_m[static_cast<std::size_t>(r)] + NearestTaskM(p, r),
+                      r);
   }
   const auto keep = static_cast<std::size_t>(std::ceil(p.num_tasks / views_per_robot));
-  if (busy.size() <= keep) return caps;
+  if (busy.size() <= keep) return p.capacity;
   std::sort(busy.begin(), busy.end());
-  std::vector<double> kept_speeds;
-  for (std::size_t i = 0; i < keep; ++i)
-    kept_speeds.push_back(speeds_mps[static_cast<std::size_t>(busy[i].second)]);
-  const std::vector<double> shared = RobotCapacities(p.num_tasks, kept_speeds);
-  std::fill(caps.begin(), caps.end(), 0.0);
-  for (std::size_t i = 0; i < keep; ++i) caps[static_cast<std::size_t>(busy[i].second)] = shared[i];
-  return caps;
+  std::vector<int> kept;
+  for (std::size_t i = 0; i < keep; ++i) kept.push_back(busy[i].second);
+  return SharedAmong(p, speeds_mps, kept);
 }
 
 double Eq4Cost(const AssignmentProblem& p, const std::vector<int>& task_robot) {
