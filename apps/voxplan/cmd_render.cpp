@@ -40,7 +40,8 @@ struct RenderOptions {
   double orbit_radius_m = 0;  // 0: from the bounds
   double orbit_height_m = 0;
   bool orbit_height_set = false;
-  double near_m = 0.0;  // maps: rays start this far out (cuts away near walls); 0: 0.01 m
+  double near_m = 0.0;          // maps: rays start this far out (cuts away near walls); 0: 0.01 m
+  std::string kernel = "auto";  // maps: "scalar" marches the scalar reference (same images)
   int threads = 0;
 };
 
@@ -85,8 +86,10 @@ class Scene {
 
 class MapScene : public Scene {
  public:
-  MapScene(TsdfVolume volume, float min_weight, float near_m) : volume_(std::move(volume)) {
+  MapScene(TsdfVolume volume, float min_weight, float near_m, bool simd)
+      : volume_(std::move(volume)) {
     params_.min_weight = min_weight;
+    params_.simd = simd;
     params_.min_depth_m = near_m > 0.0f ? near_m : 0.01f;
     // From outside a room the walls' backs come first: look through them at the inside.
     params_.stop_at_back_faces = false;
@@ -148,12 +151,13 @@ class MeshScene : public Scene {
   Eigen::AlignedBox3f bounds_;
 };
 
-Result<std::unique_ptr<Scene>> LoadScene(const std::string& path, float min_weight, float near_m) {
+Result<std::unique_ptr<Scene>> LoadScene(const std::string& path, float min_weight, float near_m,
+                                         bool simd) {
   if (IsMapPath(path)) {
     Result<TsdfVolume> volume = LoadMap(path);
     if (!volume.ok()) return volume.status();
     if (volume->num_blocks() == 0) return InvalidArgument("the map holds no blocks: " + path);
-    return std::unique_ptr<Scene>(new MapScene(std::move(*volume), min_weight, near_m));
+    return std::unique_ptr<Scene>(new MapScene(std::move(*volume), min_weight, near_m, simd));
   }
   Result<Mesh> mesh = ReadMesh(path);
   if (!mesh.ok()) return mesh.status();
@@ -181,7 +185,8 @@ int RunRender(const RenderOptions& o) {
   ThreadLimit thread_limit(o.threads);
 
   const Stopwatch load_clock;
-  Result<std::unique_ptr<Scene>> loaded = LoadScene(o.input, float(o.min_weight), float(o.near_m));
+  Result<std::unique_ptr<Scene>> loaded =
+      LoadScene(o.input, float(o.min_weight), float(o.near_m), o.kernel != "scalar");
   if (!loaded.ok()) return Fail(MessageNaming(loaded.status(), o.input));
   const Scene& scene = **loaded;
   const double load_ms = load_clock.ElapsedMs();
@@ -374,6 +379,9 @@ Command AddRenderCommand(CLI::App& app) {
   sub->add_option("--near", o->near_m,
                   "Maps: start rays this far from the camera (m), to cut away near walls")
       ->check(NonNegative());
+  sub->add_option("--kernel", o->kernel, "Maps: ray-casting march (scalar: the reference)")
+      ->check(CLI::IsMember({"auto", "scalar"}))
+      ->capture_default_str();
   sub->add_option("--threads", o->threads, "Worker threads (0: all hardware threads)")
       ->check(NonNegative())
       ->capture_default_str();
