@@ -9,10 +9,10 @@
 #include <cmath>
 #include <vector>
 
-#include "core/floor_map.h"
-#include "core/geodesic.h"
 #include "core/parallel.h"
 #include "core/volume.h"
+#include "planning/floor_map.h"
+#include "planning/geodesic.h"
 
 namespace voxplan {
 namespace {

@@ -4,9 +4,9 @@
 // Run: build/bench/voxplan_omtbench --benchmark_repetitions=10 --benchmark_report_aggregates_only
 #include <benchmark/benchmark.h>
 
-#include "plugins/omt/planner.h"
-#include "plugins/omt/raster_ops.h"
-#include "plugins/omt/task_views.h"
+#include "plugins/omt/algorithms/planner.h"
+#include "plugins/omt/algorithms/raster_ops.h"
+#include "plugins/omt/algorithms/task_views.h"
 #include "tests/plugins/omt/omt_scenes.h"
 
 namespace voxplan::omt {

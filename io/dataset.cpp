@@ -16,6 +16,8 @@
 
 #include "io/file_util.h"
 #include "io/image_io.h"
+#include "io/text_file.h"
+#include "io/tum_trajectory.h"
 
 namespace voxplan {
 namespace {
@@ -30,117 +32,6 @@ constexpr float kTumFr1[4] = {517.3f, 516.5f, 318.6f, 255.3f};
 constexpr float kIclNuim[4] = {481.20f, -480.00f, 319.5f, 239.5f};  // y axis flipped
 constexpr float kPrimeSense[4] = {525.f, 525.f, 319.5f, 239.5f};    // Open3D's default
 constexpr float kSevenScenes[4] = {585.f, 585.f, 320.f, 240.f};
-
-std::string Str(double v) {
-  std::ostringstream s;
-  s.precision(10);
-  s << v;
-  return s.str();
-}
-
-Status LineError(const std::string& file, int line, const std::string& what) {
-  return CorruptData(file + ":" + std::to_string(line) + ": " + what);
-}
-
-// ---------------------------------------------------------------------------------------------
-// Text files: a UTF-8 BOM and CRLF endings are accepted; blank lines and `#` lines are skipped.
-
-struct TextLine {
-  int number = 0;  // 1-based line in the file
-  std::vector<std::string> tokens;
-};
-
-struct TextFile {
-  std::string path;
-  std::vector<TextLine> lines;
-};
-
-Result<TextFile> ReadTextFile(const std::string& path) {
-  auto content = ReadFileToString(path);
-  if (!content.ok()) return content.status();
-  const std::string& s = *content;
-  TextFile file;
-  file.path = path;
-  size_t pos = s.compare(0, 3, "\xEF\xBB\xBF") == 0 ? 3 : 0;
-  int number = 0;
-  while (pos < s.size()) {
-    size_t end = s.find('\n', pos);
-    if (end == std::string::npos) end = s.size();
-    std::string_view line(s.data() + pos, end - pos);
-    pos = end + 1;
-    ++number;
-    if (!line.empty() && line.back() == '\r') line.remove_suffix(1);
-    TextLine parsed;
-    parsed.number = number;
-    size_t i = 0;
-    while (i < line.size()) {
-      const unsigned char c = static_cast<unsigned char>(line[i]);
-      if (c == ' ' || c == '\t') {
-        ++i;
-        continue;
-      }
-      if (c < 0x20 || c == 0x7f)
-        return LineError(path, number, "unexpected control character (not a text file?)");
-      size_t j = i;
-      while (j < line.size() && line[j] != ' ' && line[j] != '\t') ++j;
-      parsed.tokens.emplace_back(line.substr(i, j - i));
-      i = j;
-    }
-    if (parsed.tokens.empty() || parsed.tokens[0][0] == '#') continue;
-    file.lines.push_back(std::move(parsed));
-  }
-  return file;
-}
-
-bool ParseDouble(const std::string& token, double& out) {
-  const char* first = token.data();
-  const char* last = token.data() + token.size();
-  if (first != last && *first == '+') ++first;
-  const auto [ptr, ec] = std::from_chars(first, last, out);
-  return ec == std::errc() && ptr == last;
-}
-
-// Parses tokens [first, first + count) as numbers; NaN and inf parse (callers check finiteness).
-Status ParseNumbers(const TextFile& f, const TextLine& line, size_t first, size_t count,
-                    double* out) {
-  for (size_t k = 0; k < count; ++k) {
-    if (!ParseDouble(line.tokens[first + k], out[k]))
-      return LineError(f.path, line.number,
-                       "'" + line.tokens[first + k] + "' is not a number (token " +
-                           std::to_string(first + k + 1) + ")");
-  }
-  return Status::Ok();
-}
-
-Status ExpectTokens(const TextFile& f, const TextLine& line, size_t count,
-                    const std::string& format) {
-  if (line.tokens.size() != count)
-    return LineError(f.path, line.number,
-                     "expected " + std::to_string(count) + " fields '" + format + "', found " +
-                         std::to_string(line.tokens.size()));
-  return Status::Ok();
-}
-
-// Timestamps must be finite, non-negative and strictly increasing.
-class TimestampChecker {
- public:
-  Status Check(const TextFile& f, const TextLine& line, double t) {
-    if (!std::isfinite(t)) return LineError(f.path, line.number, "timestamp is not finite");
-    if (t < 0.0) return LineError(f.path, line.number, "negative timestamp " + Str(t));
-    if (has_prev_ && t == prev_)
-      return LineError(f.path, line.number, "duplicate timestamp " + Str(t));
-    if (has_prev_ && t < prev_)
-      return LineError(f.path, line.number,
-                       "timestamp " + Str(t) + " out of order (after " + Str(prev_) + ")");
-    prev_ = t;
-    has_prev_ = true;
-    return Status::Ok();
-  }
-
- private:
-  bool has_prev_ = false;
-  double prev_ = 0.0;
-};
 
 Result<Pose3d> PoseFromMatrix(const Eigen::Matrix4d& m) {
   VOXPLAN_RETURN_IF_ERROR(ValidatePoseMatrix(m));
@@ -258,7 +149,7 @@ Result<std::unique_ptr<Dataset>> Finish(Draft d, const DatasetOptions& options) 
   info.depth_scale = options.depth_scale ? *options.depth_scale : d.depth_scale;
   if (!(info.depth_scale > 0.0) || !std::isfinite(info.depth_scale))
     return InvalidArgument(d.root + ": depth scale must be positive and finite, got " +
-                           Str(info.depth_scale));
+                           NumberText(info.depth_scale));
   if (options.intrinsics) {
     const PinholeCamera& k = *options.intrinsics;
     if (!(k.fx != 0.f && k.fy != 0.f && std::isfinite(k.fx) && std::isfinite(k.fy) &&
@@ -348,28 +239,18 @@ struct StampedPose {
   Eigen::Quaterniond rotation;
 };
 
-// Lines `t tx ty tz qx qy qz qw`; a near-unit quaternion is renormalised with a warning.
+// Lines `t tx ty tz qx qy qz qw` (io/tum_trajectory.h); near-unit quaternions renormalised
+// with a warning.
 Result<std::vector<StampedPose>> ReadTumPoses(const std::string& path,
                                               std::vector<std::string>& warnings) {
-  auto file = ReadTextFile(path);
-  if (!file.ok()) return file.status();
+  Result<TumTrajectory> trajectory = ReadTumTrajectory(path, &warnings);
+  if (!trajectory.ok()) return trajectory.status();
   std::vector<StampedPose> out;
-  TimestampChecker checker;
-  for (const TextLine& line : file->lines) {
-    VOXPLAN_RETURN_IF_ERROR(ExpectTokens(*file, line, 8, "timestamp tx ty tz qx qy qz qw"));
-    double v[8];
-    VOXPLAN_RETURN_IF_ERROR(ParseNumbers(*file, line, 0, 8, v));
-    VOXPLAN_RETURN_IF_ERROR(checker.Check(*file, line, v[0]));
-    bool renormalised = false;
-    auto pose =
-        PoseFromTranslationQuaternion({v[1], v[2], v[3]}, v[4], v[5], v[6], v[7], &renormalised);
-    if (!pose.ok()) return LineError(path, line.number, pose.status().message());
-    if (renormalised)
-      warnings.push_back(path + ":" + std::to_string(line.number) + ": quaternion norm " +
-                         Str(Eigen::Vector4d(v[4], v[5], v[6], v[7]).norm()) + " renormalised");
-    out.push_back({v[0], pose->translation(), Eigen::Quaterniond(pose->linear())});
+  for (size_t i = 0; i < trajectory->T_W_C.size(); ++i) {
+    const Pose3d& pose = trajectory->T_W_C[i];
+    out.push_back(
+        {trajectory->timestamps_s[i], pose.translation(), Eigen::Quaterniond(pose.linear())});
   }
-  if (out.empty()) return CorruptData(path + ": no poses");
   return out;
 }
 
@@ -471,7 +352,7 @@ Result<Draft> ReadTum(const fs::path& root) {
       if (it != rgb.begin() && (!best || s.t - (it - 1)->t <= best->t - s.t)) best = &*(it - 1);
       if (!best || std::abs(best->t - s.t) > kTumMaxAssociationDt) {
         ++no_rgb;
-        d.warnings.push_back(where + ": no rgb frame within 0.02 s of depth " + Str(s.t) +
+        d.warnings.push_back(where + ": no rgb frame within 0.02 s of depth " + NumberText(s.t) +
                              "; frame dropped");
         continue;
       }
@@ -481,7 +362,7 @@ Result<Draft> ReadTum(const fs::path& root) {
       e.T_W_C = InterpolatePose(gt, s.t);
       if (!e.T_W_C) {
         ++no_pose;
-        d.warnings.push_back(where + ": depth " + Str(s.t) +
+        d.warnings.push_back(where + ": depth " + NumberText(s.t) +
                              " has no bracketing ground-truth poses; frame dropped");
         continue;
       }
@@ -527,24 +408,10 @@ Result<Draft> ReadIclNuim(const fs::path& root) {
   auto gt_path = FindOne(root, ".gt.freiburg");
   if (!gt_path.ok() && gt_path.status().code() != StatusCode::kNotFound) return gt_path.status();
   if (gt_path.ok()) {
-    auto gt = ReadTextFile(*gt_path);
+    Result<TumTrajectory> gt = ReadTumTrajectory(*gt_path, &d.warnings, "id tx ty tz qx qy qz qw");
     if (!gt.ok()) return gt.status();
     d.pose_source = *gt_path;
-    TimestampChecker gt_checker;
-    for (const TextLine& line : gt->lines) {
-      VOXPLAN_RETURN_IF_ERROR(ExpectTokens(*gt, line, 8, "id tx ty tz qx qy qz qw"));
-      double v[8];
-      VOXPLAN_RETURN_IF_ERROR(ParseNumbers(*gt, line, 0, 8, v));
-      VOXPLAN_RETURN_IF_ERROR(gt_checker.Check(*gt, line, v[0]));
-      bool renormalised = false;
-      auto pose =
-          PoseFromTranslationQuaternion({v[1], v[2], v[3]}, v[4], v[5], v[6], v[7], &renormalised);
-      if (!pose.ok()) return LineError(gt->path, line.number, pose.status().message());
-      if (renormalised)
-        d.warnings.push_back(gt->path + ":" + std::to_string(line.number) + ": quaternion norm " +
-                             Str(Eigen::Vector4d(v[4], v[5], v[6], v[7]).norm()) + " renormalised");
-      poses.emplace(v[0], *pose);
-    }
+    for (size_t i = 0; i < gt->T_W_C.size(); ++i) poses.emplace(gt->timestamps_s[i], gt->T_W_C[i]);
   } else {
     d.warnings.push_back(root.string() + ": no *.gt.freiburg file; frames have no pose");
   }
@@ -569,8 +436,8 @@ Result<Draft> ReadIclNuim(const fs::path& root) {
     if (it != poses.end()) {
       e.T_W_C = it->second;
     } else if (gt_path.ok()) {
-      d.warnings.push_back(e.origin + ": frame " + Str(t_depth) + " has no pose in " + *gt_path +
-                           "; kept with no pose");
+      d.warnings.push_back(e.origin + ": frame " + NumberText(t_depth) + " has no pose in " +
+                           *gt_path + "; kept with no pose");
     }
     d.entries.push_back(std::move(e));
   }

@@ -16,7 +16,7 @@
 
 #include "core/camera.h"
 #include "core/status.h"
-#include "sim/eval_trajectory.h"
+#include "io/tum_trajectory.h"
 #include "sim/raycaster.h"
 #include "sim/sensor_noise.h"
 

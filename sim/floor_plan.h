@@ -11,7 +11,7 @@
 
 namespace voxplan {
 
-// A true-plan cell (not core/floor_map.h's FloorCell, the robots' own map: explore uses both).
+// A true-plan cell (not planning/floor_map.h's FloorCell, the robots' own map: explore uses both).
 enum class PlanCell : uint8_t {
   kFree = 0,      // floor below, nothing in the height band above
   kObstacle = 1,  // a triangle crosses the height band over this cell

@@ -12,10 +12,10 @@
 
 #include "apps/voxplan/cli_common.h"
 #include "core/parallel.h"
-#include "core/planning_map.h"
-#include "fusion/integrate_planning.h"
 #include "io/dataset.h"
-#include "io/octomap_export.h"
+#include "planning/integrate_planning.h"
+#include "planning/octomap_export.h"
+#include "planning/planning_map.h"
 
 namespace voxplan::cli {
 

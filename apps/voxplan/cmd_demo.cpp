@@ -7,14 +7,14 @@
 
 #include "apps/voxplan/cli_common.h"
 #include "core/parallel.h"
+#include "eval/eval_mesh.h"
+#include "eval/visibility.h"
 #include "fusion/integrate.h"
 #include "fusion/mesh_extract.h"
 #include "io/map_io.h"
 #include "io/mesh_io.h"
 #include "sim/demo_room.h"
-#include "sim/eval_mesh.h"
 #include "sim/raycaster.h"
-#include "sim/visibility.h"
 
 namespace voxplan::cli {
 

@@ -7,12 +7,12 @@
 
 #include "apps/voxplan/cli_common.h"
 #include "core/parallel.h"
+#include "eval/eval_mesh.h"
+#include "eval/eval_trajectory.h"
+#include "eval/visibility.h"
 #include "io/dataset.h"
 #include "io/mesh_io.h"
-#include "sim/eval_mesh.h"
-#include "sim/eval_trajectory.h"
 #include "sim/raycaster.h"
-#include "sim/visibility.h"
 
 namespace voxplan::cli {
 

@@ -7,9 +7,9 @@
 
 #include "apps/voxplan/cli_common.h"
 #include "core/parallel.h"
+#include "eval/eval_objects.h"
+#include "eval/eval_run.h"
 #include "io/mesh_io.h"
-#include "sim/eval_objects.h"
-#include "sim/eval_run.h"
 #include "sim/floor_plan.h"
 #include "sim/scene_loader.h"
 

@@ -1,10 +1,10 @@
-// voxplan explore: the closed exploration loop (sim/explore.h) on a generated apartment or a
+// voxplan explore: the closed exploration loop (explore/explore.h) on a generated apartment or a
 // scene file, with a planner plugin. Writes to --out:
 //   mesh.ply        the final mesh of the fused map
 //   metrics.json    completeness (see completeness_reference), accuracy, distances, balance,
 //                   times, plan calls, termination; all but plan_ms_* repeat for a seed
 //   timeseries.csv  coverage, completeness (every 30 s, volume estimate), distance vs time
-//   run_log.csv     every robot's poses and status (sim/eval_run.h format)
+//   run_log.csv     every robot's poses and status (eval/eval_run.h format)
 //   topdown.png     the final floor map, each robot's path, start / end marks, reached views
 //   plan_log.txt    rejected tasks, failed tasks and plans, the plugin's messages
 //   plan_calls.csv  one row per plan call with its wall time and the plugin's diagnostics
@@ -21,18 +21,18 @@
 
 #include "apps/voxplan/cli_common.h"
 #include "core/parallel.h"
+#include "eval/eval_mesh.h"
+#include "eval/visibility.h"
+#include "explore/explore.h"
 #include "fusion/mesh_extract.h"
 #include "io/file_util.h"
 #include "io/image_io.h"
 #include "io/mesh_io.h"
 #include "sim/apartment.h"
-#include "sim/eval_mesh.h"
-#include "sim/explore.h"
 #include "sim/floor_plan.h"
 #include "sim/raycaster.h"
 #include "sim/scene_loader.h"
 #include "sim/tour.h"
-#include "sim/visibility.h"
 #include "viewer_offscreen/top_down.h"
 
 namespace voxplan::cli {
@@ -43,7 +43,7 @@ namespace fs = std::filesystem;
 using nlohmann::json;
 
 // The camera options' limits (exclusive): RobotParams' field-of-view bounds, and the near depth
-// frames are fused from (sim/explore.cpp), below which a range would fuse nothing.
+// frames are fused from (explore/explore.cpp), below which a range would fuse nothing.
 constexpr double kMinFovDeg = 1.0, kMaxFovDeg = 179.0;
 constexpr double kMinRangeM = 0.1;
 

@@ -16,7 +16,7 @@
 #include "io/dataset.h"
 #include "io/map_io.h"
 #include "io/mesh_io.h"
-#include "sim/eval_trajectory.h"
+#include "io/tum_trajectory.h"
 
 namespace voxplan::cli {
 

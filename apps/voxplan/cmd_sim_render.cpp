@@ -10,8 +10,8 @@
 #include "apps/voxplan/cli_common.h"
 #include "core/parallel.h"
 #include "io/file_util.h"
+#include "io/tum_trajectory.h"
 #include "sim/dataset_writer.h"
-#include "sim/eval_trajectory.h"
 #include "sim/raycaster.h"
 #include "sim/scene_loader.h"
 

@@ -8,7 +8,7 @@
 
 #include "apps/voxplan/cli_common.h"
 #include "core/parallel.h"
-#include "sim/eval_trajectory.h"
+#include "io/tum_trajectory.h"
 #include "sim/floor_plan.h"
 #include "sim/scene_loader.h"
 #include "sim/tour.h"

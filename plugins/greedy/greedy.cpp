@@ -16,7 +16,7 @@
 #include <string>
 #include <vector>
 
-#include "plugins/baselines/baseline.h"
+#include "plugins/common/baseline.h"
 #include "plugins/planner_cpp.h"
 
 namespace voxplan::planners {

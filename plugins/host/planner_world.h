@@ -12,7 +12,7 @@
 #include <string>
 #include <vector>
 
-#include "core/floor_map.h"
+#include "core/floor_cell.h"
 #include "core/status.h"
 #include "core/voxel_state.h"
 

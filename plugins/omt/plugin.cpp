@@ -7,8 +7,8 @@
 #include <string>
 #include <vector>
 
-#include "plugins/baselines/world_input.h"
-#include "plugins/omt/planner.h"
+#include "plugins/common/world_input.h"
+#include "plugins/omt/algorithms/planner.h"
 #include "plugins/planner_cpp.h"
 
 namespace voxplan::planners {

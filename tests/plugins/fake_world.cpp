@@ -3,8 +3,8 @@
 #include <algorithm>
 #include <cmath>
 
-#include "core/geodesic.h"
 #include "core/image.h"
+#include "planning/geodesic.h"
 
 namespace voxplan::test {
 

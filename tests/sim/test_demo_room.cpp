@@ -9,9 +9,9 @@
 #include <set>
 #include <tuple>
 
+#include "eval/visibility.h"
 #include "sim/demo_room.h"
 #include "sim/raycaster.h"
-#include "sim/visibility.h"
 
 namespace voxplan {
 namespace {

@@ -15,7 +15,7 @@
 #include <vector>
 
 #include "io/mesh_io.h"
-#include "sim/eval_trajectory.h"
+#include "io/tum_trajectory.h"
 #include "sim/scene_loader.h"
 #include "sim/world_io.h"
 #include "tests/support/test_support.h"

@@ -5,7 +5,7 @@
 #include <cmath>
 #include <vector>
 
-#include "plugins/omt/types.h"
+#include "plugins/omt/algorithms/types.h"
 
 namespace voxplan::omt::testing {
 

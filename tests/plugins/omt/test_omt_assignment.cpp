@@ -3,7 +3,7 @@
 #include <cmath>
 #include <random>
 
-#include "plugins/omt/assignment.h"
+#include "plugins/omt/algorithms/assignment.h"
 
 namespace voxplan::omt {
 namespace {

@@ -3,8 +3,8 @@
 #include <cmath>
 #include <random>
 
-#include "plugins/omt/geodesic.h"
-#include "plugins/omt/raster_ops.h"
+#include "plugins/omt/algorithms/geodesic.h"
+#include "plugins/omt/algorithms/raster_ops.h"
 #include "tests/plugins/omt/omt_scenes.h"
 
 namespace voxplan::omt {

@@ -4,8 +4,8 @@
 #include <set>
 #include <thread>
 
-#include "plugins/omt/planner.h"
-#include "plugins/omt/raster_ops.h"
+#include "plugins/omt/algorithms/planner.h"
+#include "plugins/omt/algorithms/raster_ops.h"
 #include "tests/plugins/omt/omt_scenes.h"
 
 namespace voxplan::omt {

@@ -4,8 +4,8 @@
 #include <cmath>
 #include <utility>
 
-#include "plugins/omt/raster_ops.h"
-#include "plugins/omt/smoothing.h"
+#include "plugins/omt/algorithms/raster_ops.h"
+#include "plugins/omt/algorithms/smoothing.h"
 #include "tests/plugins/omt/omt_scenes.h"
 
 namespace voxplan::omt {

@@ -3,8 +3,8 @@
 #include <cmath>
 #include <set>
 
-#include "plugins/omt/raster_ops.h"
-#include "plugins/omt/task_views.h"
+#include "plugins/omt/algorithms/raster_ops.h"
+#include "plugins/omt/algorithms/task_views.h"
 #include "tests/plugins/omt/omt_scenes.h"
 
 namespace voxplan::omt {

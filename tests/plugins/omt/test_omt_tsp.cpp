@@ -4,7 +4,7 @@
 #include <numeric>
 #include <random>
 
-#include "plugins/omt/tsp.h"
+#include "plugins/omt/algorithms/tsp.h"
 
 namespace voxplan::omt {
 namespace {

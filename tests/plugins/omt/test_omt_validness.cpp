@@ -2,7 +2,7 @@
 
 #include <cmath>
 
-#include "plugins/omt/validness.h"
+#include "plugins/omt/algorithms/validness.h"
 #include "tests/plugins/omt/omt_scenes.h"
 
 namespace voxplan::omt {
