@@ -2,8 +2,8 @@
 // What the engine shows a planner plugin, as a C++ interface: `voxplan explore` implements it
 // over the real maps (TSDF volume, floor map, objects, simulated robots); tests implement it over
 // a small grid. The plugin host adapts it to the C table of plugins/planner_api.h, so a plugin
-// never sees these types. Geodesic queries have default implementations over Floor()
-// (8-connected Dijkstra) that a world with its own distance fields may override.
+// never sees these types. Geodesic queries have no default: a world answers them from its own
+// distance fields, so the host never runs a second geodesic engine beside the world's.
 //
 // Frames and units as in planner_api.h: world Z up, metres, radians; yaw from +x towards +y.
 #include <Eigen/Core>
@@ -133,14 +133,14 @@ class PlannerWorld {
   // Geodesic distance from source to every floor cell over cells traversable with
   // min_clearance_m (the source cell is always entered); +inf where unreachable.
   virtual Result<std::vector<float>> GeodesicField(const Eigen::Vector2f& source_m,
-                                                   float min_clearance_m) const;
+                                                   float min_clearance_m) const = 0;
   // Row-major n x n geodesic distances between the points.
   virtual Result<std::vector<float>> DistanceMatrix(std::span<const Eigen::Vector2f> points_m,
-                                                    float min_clearance_m) const;
+                                                    float min_clearance_m) const = 0;
   // Polyline from -> to through cell centres; NotFound when unreachable.
   virtual Result<std::vector<Eigen::Vector2f>> ShortestPath(const Eigen::Vector2f& from_m,
                                                             const Eigen::Vector2f& to_m,
-                                                            float min_clearance_m) const;
+                                                            float min_clearance_m) const = 0;
 };
 
 }  // namespace voxplan

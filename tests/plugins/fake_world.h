@@ -5,7 +5,8 @@
 // and rays read the floor column at any z; surface voxels are the obstacle cells with a free
 // 4-neighbour (at z 0.5 m, facing that neighbour, one weight for all); frontier cells (free and
 // 8-adjacent to unknown) and clearance (cell centre to the nearest obstacle cell centre) are
-// derived by Finish(), which must follow the drawing.
+// derived by Finish(), which must follow the drawing. Geodesic queries are an 8-connected
+// Dijkstra over the floor raster (diagonals never cut an obstacle corner; ties pop in cell order).
 //
 // FakeWorld: a small hand-made RasterWorld, 20 x 12 floor cells of 0.25 m, two rooms joined by a
 // 3-cell door, an enclosed free pocket no robot can reach, and an unknown patch in the right room
@@ -54,6 +55,13 @@ class RasterWorld : public PlannerWorld {
   std::vector<SurfaceVoxel> SurfaceVoxels() const override;
   const PlannerFloor& Floor() const override { return floor_; }
   std::vector<PlannerRobot> Robots() const override { return robots_; }
+  Result<std::vector<float>> GeodesicField(const Eigen::Vector2f& source_m,
+                                           float min_clearance_m) const override;
+  Result<std::vector<float>> DistanceMatrix(std::span<const Eigen::Vector2f> points_m,
+                                            float min_clearance_m) const override;
+  Result<std::vector<Eigen::Vector2f>> ShortestPath(const Eigen::Vector2f& from_m,
+                                                    const Eigen::Vector2f& to_m,
+                                                    float min_clearance_m) const override;
 
   // Cell centre in world metres.
   Eigen::Vector2f Center(int ix, int iy) const { return floor_.CellCenter(ix, iy); }

@@ -1,0 +1,137 @@
+// Validation of what a plugin's plan() returned: tasks, paths, camera trajectories,
+// diagnostics and drawings that cannot be used are dropped one by one and logged as rejections.
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "plugins/host/host_internal.h"
+
+namespace voxplan::internal {
+namespace {
+
+// Why a task cannot be executed, or "" when it can. `field` is the robot's geodesic field (may
+// be empty when the world could not compute one).
+std::string TaskProblem(const PlannerTask& t, const PlannerRobot& robot, const PlannerMapInfo& map,
+                        const PlannerFloor& floor, const std::vector<float>& field,
+                        const PlanValidation& v) {
+  const auto fmt = [](float x) {
+    char buf[32];
+    std::snprintf(buf, sizeof buf, "%.3g", double(x));
+    return std::string(buf);
+  };
+  if (!AllFinite({t.position_m.x(), t.position_m.y(), t.theta_rad, t.camera_yaw_rad,
+                  t.camera_pitch_rad, t.dwell_s})) {
+    return "non-finite number";
+  }
+  if (t.dwell_s < 0.f || t.dwell_s > v.max_dwell_s) {
+    return "dwell " + fmt(t.dwell_s) + " s outside [0, " + fmt(v.max_dwell_s) + "]";
+  }
+  const size_t modes = std::max<size_t>(robot.modes.size(), 1);
+  if (t.mode < 0 || size_t(t.mode) >= modes) {
+    return "mode " + std::to_string(t.mode) + " unknown (robot has " + std::to_string(modes) + ")";
+  }
+  if (t.camera_pitch_rad < robot.min_pitch_rad || t.camera_pitch_rad > robot.max_pitch_rad) {
+    return "camera pitch " + fmt(t.camera_pitch_rad) + " rad outside the robot's limits";
+  }
+  const std::string at = " at (" + fmt(t.position_m.x()) + ", " + fmt(t.position_m.y()) + ")";
+  if ((t.position_m.array() < map.bounds_min.head<2>().array()).any() ||
+      (t.position_m.array() > map.bounds_max.head<2>().array()).any()) {
+    return "outside the map bounds" + at;
+  }
+  const Eigen::Vector2i c = floor.CellOf(t.position_m);
+  if (!floor.Contains(c.x(), c.y())) return "outside the floor raster" + at;
+  const size_t i = floor.Linear(c.x(), c.y());
+  if (floor.cells[i] == FloorCell::kObstacle) return "inside an obstacle" + at;
+  if (floor.cells[i] == FloorCell::kUnknown) return "in unknown space" + at;
+  const float needed = robot.radius_m + v.clearance_margin_m;
+  if (floor.clearance_m[i] < needed) {
+    return "too close to an obstacle" + at + " (clearance " + fmt(floor.clearance_m[i]) + " m < " +
+           fmt(needed) + " m)";
+  }
+  if (field.size() != floor.cells.size() || !std::isfinite(field[i])) {
+    return "unreachable from the robot" + at;
+  }
+  return "";
+}
+
+void Reject(PlanResult& result, const std::string& planner, int32_t robot, int32_t task,
+            const std::string& reason) {
+  result.rejections.push_back({robot, task, reason});
+  std::string where = robot >= 0 ? "robot " + std::to_string(robot) + " " : "";
+  if (task >= 0) where += "task " + std::to_string(task) + " ";
+  result.log.push_back(
+      {VP_LOG_WARNING, "planner " + planner + ": " + where + "rejected: " + reason});
+}
+
+}  // namespace
+
+void Validate(const PlannerWorld& world, const std::vector<PlannerRobot>& robots,
+              const PlanValidation& v, const std::string& planner, PlanResult& result) {
+  const PlannerMapInfo map = world.MapInfo();
+  const PlannerFloor& floor = world.Floor();
+  for (size_t r = 0; r < result.robots.size(); ++r) {
+    RobotPlan& plan = result.robots[r];
+    const PlannerRobot& robot = robots[r];
+    std::vector<float> field;
+    if (!plan.tasks.empty()) {
+      Result<std::vector<float>> f =
+          world.GeodesicField(robot.position_m, robot.radius_m + v.clearance_margin_m);
+      if (f.ok()) field = std::move(f).value();
+    }
+    std::vector<PlannerTask> kept;
+    for (size_t t = 0; t < plan.tasks.size(); ++t) {
+      const std::string problem = TaskProblem(plan.tasks[t], robot, map, floor, field, v);
+      if (problem.empty()) {
+        kept.push_back(plan.tasks[t]);
+      } else {
+        Reject(result, planner, int32_t(r), int32_t(t), problem);
+      }
+    }
+    plan.tasks = std::move(kept);
+    for (size_t i = 0; i < plan.path.size(); ++i) {
+      const PathPoint& p = plan.path[i];
+      if (!p.position_m.allFinite() || !std::isfinite(p.theta_rad)) {
+        Reject(result, planner, int32_t(r), -1,
+               "path dropped: point " + std::to_string(i) + " is not finite");
+        plan.path.clear();
+        break;
+      }
+    }
+    for (size_t i = 0; i < plan.camera_trajectory.size(); ++i) {
+      const CameraSample& s = plan.camera_trajectory[i];
+      const bool finite = s.position_m.allFinite() && AllFinite({s.t_s, s.yaw_rad, s.pitch_rad});
+      if (!finite || (i > 0 && s.t_s < plan.camera_trajectory[i - 1].t_s)) {
+        Reject(result, planner, int32_t(r), -1,
+               "camera trajectory dropped: sample " + std::to_string(i) +
+                   (finite ? " goes back in time" : " is not finite"));
+        plan.camera_trajectory.clear();
+        break;
+      }
+    }
+  }
+  std::vector<std::pair<std::string, double>> diagnostics;
+  for (auto& [name, value] : result.diagnostics) {
+    if (std::isfinite(value)) {
+      diagnostics.emplace_back(std::move(name), value);
+    } else {
+      Reject(result, planner, -1, -1, "diagnostic '" + name + "' is not finite");
+    }
+  }
+  result.diagnostics = std::move(diagnostics);
+  std::vector<DebugDrawing> drawings;
+  for (DebugDrawing& d : result.drawings) {
+    bool finite = true;
+    for (const Eigen::Vector3f& p : d.points) finite = finite && p.allFinite();
+    if (finite) {
+      drawings.push_back(std::move(d));
+    } else {
+      Reject(result, planner, -1, -1, "debug drawing in layer '" + d.layer + "' is not finite");
+    }
+  }
+  result.drawings = std::move(drawings);
+}
+
+}  // namespace voxplan::internal
