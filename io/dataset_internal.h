@@ -1,0 +1,90 @@
+#pragma once
+// What io/dataset*.cpp share: the Draft a reader fills (frames found, intrinsics, warnings) and
+// OpenDataset finishes into a Dataset, the known cameras, the readers, and the parsing helpers
+// more than one reader uses. Internal to io/dataset*; io/dataset.h is the public face.
+#include <Eigen/Core>
+#include <algorithm>
+#include <filesystem>
+#include <nlohmann/json_fwd.hpp>
+#include <optional>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "core/pose.h"
+#include "core/status.h"
+#include "io/dataset.h"
+#include "io/text_file.h"
+
+namespace voxplan::dataset {
+
+namespace fs = std::filesystem;
+
+// Datasets without timestamps were 30 Hz sensors.
+inline constexpr double kNoTimestampRateHz = 30.0;
+
+// Known cameras for datasets that ship no intrinsics file.
+inline constexpr float kTumFr1[4] = {517.3f, 516.5f, 318.6f, 255.3f};
+inline constexpr float kIclNuim[4] = {481.20f, -480.00f, 319.5f, 239.5f};  // y axis flipped
+inline constexpr float kPrimeSense[4] = {525.f, 525.f, 319.5f, 239.5f};    // Open3D's default
+inline constexpr float kSevenScenes[4] = {585.f, 585.f, 320.f, 240.f};
+
+// One frame as a reader lists it; the Dataset decodes it on Load.
+struct Entry {
+  std::string depth_path;
+  std::string color_path;  // empty: no colour
+  double timestamp = 0.0;
+  std::optional<Pose3d> T_W_C;
+  std::string origin;  // "file:line" the entry came from, for error messages
+};
+
+// What a reader found, before options and common checks are applied.
+struct Draft {
+  DatasetFormat format = DatasetFormat::kAuto;
+  std::string root;
+  std::vector<Entry> entries;
+  float intrinsics[4] = {0, 0, 0, 0};  // fx fy cx cy
+  std::string intrinsics_source;
+  std::string default_intrinsics_warning;  // added only if the caller gave no intrinsics
+  double depth_scale = 0.0;
+  int stated_width = 0, stated_height = 0;  // from the intrinsics file, when it states a size
+  std::string pose_source = "none";
+  std::vector<std::string> warnings;
+  std::string empty_message;  // why there are no frames, when there are none
+};
+
+inline void SetIntrinsics(Draft& d, const float (&k)[4]) { std::copy(k, k + 4, d.intrinsics); }
+
+// The readers, one per format family; each returns a Draft for OpenDataset to finish.
+Result<Draft> ReadTum(const fs::path& root);      // io/dataset_tum.cpp
+Result<Draft> ReadIclNuim(const fs::path& root);  // io/dataset_tum.cpp
+Result<Draft> ReadRedwood(const fs::path& root);  // io/dataset_redwood.cpp
+// 7-Scenes and 3DMatch; io/dataset_frame_folders.cpp.
+Result<Draft> ReadFrameFolders(const fs::path& root, DatasetFormat format);
+Result<Draft> ReadReplica(const fs::path& root);  // io/dataset_replica.cpp
+
+// Helpers more than one reader uses, in io/dataset.cpp.
+Result<Pose3d> PoseFromMatrix(const Eigen::Matrix4d& m);  // checked by ValidatePoseMatrix
+// Rows of 4 numbers starting at lines[first]; errors name the first offending line.
+Result<Pose3d> ParseMatrixRows(const TextFile& f, size_t first);
+// Picks the depth path of a pair: the one mentioning "depth" when exactly one does (TUM's
+// associate.py writes rgb first, ICL-NUIM writes depth first); otherwise `default_first`.
+bool DepthIsFirst(const std::string& a, const std::string& b, bool default_first);
+// JSON (Redwood camera file, Replica cam_params.json); parse errors name the line.
+Result<nlohmann::json> ReadJson(const std::string& path);
+Result<double> JsonNumber(const nlohmann::json& obj, const std::string& key,
+                          const std::string& path);
+
+// The first (sorted) file in `dir` whose name ends in `suffix`; ICL-NUIM's *.gt.freiburg, also
+// used by detection. In io/dataset_tum.cpp.
+Result<std::string> FindOne(const fs::path& dir, const std::string& suffix);
+
+// The frame-file listing of io/dataset_frame_folders.cpp, also used by Replica and detection.
+// Files `prefix<id>suffix` of one folder, sorted by id; a duplicate id is an error.
+Result<std::vector<std::pair<long, std::string>>> ListFrames(const fs::path& dir,
+                                                             const std::string& prefix,
+                                                             const std::string& suffix);
+bool HasFrames(const fs::path& dir);                          // any frame-XXXXXX.depth.png in dir
+std::vector<fs::path> SequenceFolders(const fs::path& root);  // seq*/ folders with frames, sorted
+
+}  // namespace voxplan::dataset

@@ -1,0 +1,115 @@
+// Replica in the NICE-SLAM layout: cam_params.json, <scene>/results/{depth,frame}NNNNNN and
+// traj.txt (one row-major 4x4 pose per line, line k is frame k).
+#include <Eigen/Core>
+#include <algorithm>
+#include <filesystem>
+#include <nlohmann/json.hpp>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "io/dataset_internal.h"
+#include "io/text_file.h"
+
+namespace voxplan::dataset {
+
+Result<Draft> ReadReplica(const fs::path& root) {
+  Draft d;
+  d.format = DatasetFormat::kReplica;
+  d.root = root.string();
+  std::error_code ec;
+
+  fs::path scene;
+  std::string params;
+  if (fs::is_directory(root / "results", ec)) {  // pointed at the scene folder
+    scene = root;
+    params = fs::exists(root / "cam_params.json", ec)
+                 ? (root / "cam_params.json").string()
+                 : (root.parent_path() / "cam_params.json").string();
+  } else {
+    params = (root / "cam_params.json").string();
+    std::vector<fs::path> scenes;
+    for (const auto& entry : fs::directory_iterator(root, ec))
+      if (entry.is_directory(ec) && fs::is_directory(entry.path() / "results", ec))
+        scenes.push_back(entry.path());
+    std::sort(scenes.begin(), scenes.end());
+    if (scenes.empty())
+      return NotFound(root.string() + ": no scene folder with results/ (e.g. office0/results)");
+    if (scenes.size() > 1) {
+      std::string names;
+      for (const auto& s : scenes) names += " " + s.filename().string();
+      return InvalidArgument(root.string() + ": several Replica scenes (" + names.substr(1) +
+                             "); open one of them");
+    }
+    scene = scenes.front();
+  }
+
+  auto json = ReadJson(params);
+  if (!json.ok()) return json.status();
+  if (!json->is_object() || !json->contains("camera") || !(*json)["camera"].is_object())
+    return CorruptData(params + ": expected an object 'camera' with w h fx fy cx cy scale");
+  const nlohmann::json& cam = (*json)["camera"];
+  double v[7];
+  const char* keys[7] = {"w", "h", "fx", "fy", "cx", "cy", "scale"};
+  for (int i = 0; i < 7; ++i) {
+    auto x = JsonNumber(cam, keys[i], params);
+    if (!x.ok()) return x.status();
+    v[i] = *x;
+  }
+  d.stated_width = int(v[0]);
+  d.stated_height = int(v[1]);
+  d.intrinsics[0] = float(v[2]);
+  d.intrinsics[1] = float(v[3]);
+  d.intrinsics[2] = float(v[4]);
+  d.intrinsics[3] = float(v[5]);
+  d.depth_scale = v[6];
+  d.intrinsics_source = params;
+
+  const fs::path results = scene / "results";
+  auto depth = ListFrames(results, "depth", ".png");
+  if (!depth.ok()) return depth.status();
+  for (const auto& [id, path] : *depth) {
+    Entry e;
+    e.depth_path = path;
+    const std::string digits = fs::path(path).stem().string().substr(5);
+    for (const char* ext : {".jpg", ".png"}) {
+      const fs::path color = results / ("frame" + digits + ext);
+      if (fs::exists(color, ec)) e.color_path = color.string();
+    }
+    e.timestamp = double(id) / kNoTimestampRateHz;
+    d.entries.push_back(std::move(e));
+  }
+  d.empty_message = results.string() + ": no depthNNNNNN.png images";
+
+  // traj.txt holds a pose for every frame of the full sequence; line k (0-based) is frame k.
+  const std::string traj = (scene / "traj.txt").string();
+  if (fs::exists(traj, ec)) {
+    auto file = ReadTextFile(traj);
+    if (!file.ok()) return file.status();
+    std::vector<Pose3d> poses;
+    poses.reserve(file->lines.size());
+    for (const TextLine& line : file->lines) {
+      VOXPLAN_RETURN_IF_ERROR(ExpectTokens(*file, line, 16, "16 numbers, a row-major 4x4"));
+      double m[16];
+      VOXPLAN_RETURN_IF_ERROR(ParseNumbers(*file, line, 0, 16, m));
+      auto pose = PoseFromMatrix(Eigen::Map<const Eigen::Matrix<double, 4, 4, Eigen::RowMajor>>(m));
+      if (!pose.ok()) return LineError(traj, line.number, pose.status().message());
+      poses.push_back(*pose);
+    }
+    d.pose_source = traj;
+    for (size_t i = 0; i < d.entries.size(); ++i) {
+      const long id = (*depth)[i].first;
+      if (size_t(id) < poses.size()) {
+        d.entries[i].T_W_C = poses[size_t(id)];
+      } else {
+        d.warnings.push_back(traj + ": no pose for frame " + std::to_string(id) + " (" +
+                             std::to_string(poses.size()) + " poses); kept with no pose");
+      }
+    }
+  } else {
+    d.warnings.push_back(traj + ": not found; frames have no pose");
+  }
+  return d;
+}
+
+}  // namespace voxplan::dataset
