@@ -37,7 +37,10 @@ Result<Draft> ReadReplica(const fs::path& root) {
       return NotFound(root.string() + ": no scene folder with results/ (e.g. office0/results)");
     if (scenes.size() > 1) {
       std::string names;
-      for (const auto& s : scenes) names += " " + s.filename().string();
+      for (const auto& s : scenes) {
+        names += ' ';
+        names += s.filename().string();
+      }
       return InvalidArgument(root.string() + ": several Replica scenes (" + names.substr(1) +
                              "); open one of them");
     }

@@ -2,6 +2,8 @@
 
 #include <charconv>
 #include <cmath>
+#include <cstdio>
+#include <cstdlib>
 #include <sstream>
 #include <string_view>
 
@@ -14,6 +16,12 @@ std::string NumberText(double v) {
   s.precision(10);
   s << v;
   return s.str();
+}
+
+double ShortestDouble(float value) {
+  char text[32];
+  std::snprintf(text, sizeof(text), "%.7g", double(value));
+  return std::strtod(text, nullptr);
 }
 
 Status LineError(const std::string& file, int line, const std::string& what) {

@@ -27,6 +27,9 @@ Status LineError(const std::string& file, int line, const std::string& what);
 
 // `v` with up to 10 significant digits, for messages.
 std::string NumberText(double v);
+// A float as the double with the same shortest decimal form (0.02f -> 0.02, not 0.0199999...),
+// for JSON outputs.
+double ShortestDouble(float value);
 
 // A whole token as a double (a leading '+' accepted; NaN and inf parse: callers check).
 bool ParseDouble(const std::string& token, double& out);

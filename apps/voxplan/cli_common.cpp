@@ -259,12 +259,6 @@ double RoundTo(double value, int decimals) {
   return std::round(value * scale) / scale;
 }
 
-double FloatValue(float value) {
-  char text[32];
-  std::snprintf(text, sizeof(text), "%.7g", double(value));
-  return std::strtod(text, nullptr);
-}
-
 double Mib(size_t bytes) { return RoundTo(double(bytes) / (1024.0 * 1024.0), 3); }
 
 Status WriteJsonFile(const nlohmann::json& json, const std::string& path) {
@@ -286,24 +280,6 @@ void AddMeshStats(nlohmann::json& j, const Mesh& mesh, double mesh_ms) {
   j["mesh_vertices"] = mesh.num_vertices();
   j["mesh_triangles"] = mesh.num_triangles();
   j["mesh_ms"] = RoundTo(mesh_ms, 3);
-}
-
-nlohmann::json FrameListEntry(const std::string& depth_path, const std::string& color_path,
-                              const Eigen::Matrix4d& T_W_C) {
-  const Eigen::Matrix<double, 4, 4, Eigen::RowMajor> T = T_W_C;
-  return {{"depth", depth_path},
-          {"color", color_path},
-          {"T_W_C", std::vector<double>(T.data(), T.data() + 16)}};
-}
-
-nlohmann::json FrameList(const PinholeCamera& camera, double depth_scale, double voxel_size_m,
-                         double trunc_m, double min_depth_m, double max_depth_m,
-                         nlohmann::json frames) {
-  return {
-      {"width", camera.width},       {"height", camera.height},      {"fx", FloatValue(camera.fx)},
-      {"fy", FloatValue(camera.fy)}, {"cx", FloatValue(camera.cx)},  {"cy", FloatValue(camera.cy)},
-      {"depth_scale", depth_scale},  {"voxel_size_m", voxel_size_m}, {"trunc_m", trunc_m},
-      {"min_depth_m", min_depth_m},  {"max_depth_m", max_depth_m},   {"frames", std::move(frames)}};
 }
 
 }  // namespace voxplan::cli

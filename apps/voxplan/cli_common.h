@@ -13,8 +13,10 @@
 #include "core/camera.h"
 #include "core/mesh.h"
 #include "core/status.h"
+#include "core/stopwatch.h"
 #include "core/volume.h"
 #include "io/dataset.h"
+#include "io/text_file.h"
 #include "sim/scene_loader.h"
 
 namespace voxplan::cli {
@@ -102,18 +104,6 @@ struct TimingSummary {
 };
 TimingSummary Summarize(std::vector<double> values_ms);
 
-class Stopwatch {
- public:
-  Stopwatch() : start_(std::chrono::steady_clock::now()) {}
-  double ElapsedMs() const {
-    return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start_)
-        .count();
-  }
-
- private:
-  std::chrono::steady_clock::time_point start_;
-};
-
 // Progress on stderr: a redrawn bar on a terminal, else a plain line every ~10% so logs
 // stay short.
 class Progress {
@@ -141,16 +131,7 @@ double PeakRssMb();  // MiB, from getrusage
 void AddMapStats(nlohmann::json& j, const TsdfVolume& volume);
 void AddMeshStats(nlohmann::json& j, const Mesh& mesh, double mesh_ms);
 
-// The frame list `fuse --frame-list` writes and bench/open3d_fusion.py reads: one entry per
-// integrated frame (image paths, row-major camera-to-world), then the camera and parameters.
-nlohmann::json FrameListEntry(const std::string& depth_path, const std::string& color_path,
-                              const Eigen::Matrix4d& T_W_C);
-nlohmann::json FrameList(const PinholeCamera& camera, double depth_scale, double voxel_size_m,
-                         double trunc_m, double min_depth_m, double max_depth_m,
-                         nlohmann::json frames);
 double RoundTo(double value, int decimals);
-// A float as the double with the same shortest decimal form (0.02f -> 0.02, not 0.0199999...).
-double FloatValue(float value);
 double Mib(size_t bytes);
 
 // Writes JSON (pretty) through WriteAtomically; the error names the file.

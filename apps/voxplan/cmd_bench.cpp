@@ -28,6 +28,8 @@
 #include "fusion/integrate.h"
 #include "fusion/mesh_extract.h"
 #include "io/dataset.h"
+#include "io/frame_list.h"
+#include "pipeline/fuse_dataset.h"
 
 extern char** environ;
 
@@ -59,12 +61,6 @@ struct BenchOptions {
   std::string kernel = "auto";
   bool vs_open3d = false;
   std::string json_path;
-};
-
-// One integrated frame: what the raycast poses and the Open3D frame list need.
-struct FrameRecord {
-  Pose3d T_W_C;
-  std::string depth_path, color_path;
 };
 
 struct Row {
@@ -108,10 +104,6 @@ Result<std::vector<int>> ParseThreadList(const std::string& text) {
   std::sort(threads.begin(), threads.end());
   threads.erase(std::unique(threads.begin(), threads.end()), threads.end());
   return threads;
-}
-
-bool AllZero(const DepthImage& depth) {
-  return std::none_of(depth.data.begin(), depth.data.end(), [](float z) { return z > 0.f; });
 }
 
 int Nproc() {
@@ -346,39 +338,38 @@ int RunBench(const BenchOptions& o, BenchMode mode) {
             << (o.threads.empty() ? "1,all" : "") << ", " << o.repeat << " repeats, kernel "
             << kernel_name << " (raycast " << raycast_kernel_name << ")" << std::endl;
 
-  // Recorded on the first pass only: the frames integrated, in order.
-  std::vector<FrameRecord> records;
+  // Recorded on the first pass only: the frames integrated, in order, and the skipped ones.
+  std::vector<FusedFrame> records;
   size_t skipped_no_pose = 0, skipped_no_depth = 0;
   bool first_pass = true;
+  FuseParams fuse_params;
+  fuse_params.integrate = params;
   // Streams every selected frame into `volume` (decode timed apart from integration).
   // With `mesher`, each frame's changed blocks (found untimed) are meshed again, timed.
   auto fuse = [&](TsdfVolume& volume, std::vector<double>* integrate_ms,
                   std::vector<double>* load_ms, IncrementalMesher* mesher = nullptr,
                   std::vector<double>* mesh_update_ms = nullptr) -> Status {
-    for (size_t i : indices) {
-      const Stopwatch load_clock;
-      Result<Frame> frame = dataset.Load(i);
-      const double load = load_clock.ElapsedMs();
-      if (!frame.ok()) return frame.status().WithContext("frame " + std::to_string(i));
-      if (!frame->T_W_C || AllZero(frame->depth)) {
-        if (first_pass) ++(frame->T_W_C ? skipped_no_depth : skipped_no_pose);
-        continue;
-      }
-      const Stopwatch integrate_clock;
-      Result<IntegrateStats> stats = IntegrateFrame(frame->depth, frame->color, info.camera,
-                                                    frame->T_W_C->cast<float>(), params, volume);
-      const double integrate = integrate_clock.ElapsedMs();
-      if (!stats.ok()) return Status(stats.status()).WithContext(frame->depth_path);
-      if (integrate_ms) integrate_ms->push_back(integrate);
-      if (load_ms) load_ms->push_back(load);
-      if (mesher) {
-        const std::vector<BlockIndex> changed = BlocksInTruncationBand(
-            frame->depth, info.camera, frame->T_W_C->cast<float>(), params, volume.params());
+    FuseObserver observer;
+    if (mesher) {
+      observer.integrated = [&](const Frame& frame, const Pose3f& T_W_C, TsdfVolume& v) {
+        const std::vector<BlockIndex> changed =
+            BlocksInTruncationBand(frame.depth, info.camera, T_W_C, params, v.params());
         const Stopwatch mesh_clock;
-        mesher->Update(volume, changed);
+        mesher->Update(v, changed);
         mesh_update_ms->push_back(mesh_clock.ElapsedMs());
-      }
-      if (first_pass) records.push_back({*frame->T_W_C, frame->depth_path, frame->color_path});
+        return Status::Ok();
+      };
+    }
+    Result<FuseReport> report = FuseDataset(dataset, indices, fuse_params, volume, observer);
+    if (!report.ok()) return report.status();
+    if (integrate_ms)
+      integrate_ms->insert(integrate_ms->end(), report->integrate_ms.begin(),
+                           report->integrate_ms.end());
+    if (load_ms) load_ms->insert(load_ms->end(), report->load_ms.begin(), report->load_ms.end());
+    if (first_pass) {
+      records = report->frames;
+      skipped_no_pose = report->skipped_no_pose;
+      skipped_no_depth = report->skipped_no_depth;
     }
     first_pass = false;
     return Status::Ok();
@@ -391,7 +382,7 @@ int RunBench(const BenchOptions& o, BenchMode mode) {
     for (int r = 0; r < rounds; ++r) {
       for (size_t k : poses) {
         const Stopwatch clock;
-        Raycast(volume, info.camera, records[k].T_W_C.cast<float>(), raycast_params, images);
+        Raycast(volume, info.camera, records[k].T_W_C, raycast_params, images);
         ms.push_back(clock.ElapsedMs());
         if (r == 0) {
           pixels += images.status.data.size();
@@ -481,14 +472,15 @@ int RunBench(const BenchOptions& o, BenchMode mode) {
 
   const std::vector<size_t> raycast_poses = RaycastPoseIndexes(records.size());
   if (o.vs_open3d) {
-    json frames = json::array();
-    for (const FrameRecord& r : records) {
-      frames.push_back(FrameListEntry(r.depth_path, r.color_path, r.T_W_C.matrix()));
-    }
+    // Exactly the poses voxplan integrated, as `fuse --frame-list` writes them.
+    std::vector<FrameListEntry> frames;
+    for (const FusedFrame& r : records)
+      frames.push_back({r.depth_path, r.color_path, r.T_W_C.matrix().cast<double>()});
     // The layout of `fuse --frame-list`, plus a VBG capacity sized from voxplan's map: VBG
     // allocates and touches all of it up front, so a guess would decide its RSS.
-    json list = FrameList(info.camera, info.depth_scale, o.voxel_size_m, o.trunc_m,
-                          o.in.min_depth_m, o.in.max_depth_m, frames);
+    const FrameListParams list_params{info.camera, info.depth_scale, o.voxel_size_m,
+                                      o.trunc_m,   o.in.min_depth_m, o.in.max_depth_m};
+    json list = json::parse(FrameListJson(list_params, frames, -1));
     list["vbg_block_count"] = std::max<size_t>(1024, rows.back().blocks * 5 / 4);
     TempFrameList list_file;
     if (Status s = list_file.Write(list); !s.ok()) return Fail(s.message());
@@ -581,9 +573,9 @@ int RunBench(const BenchOptions& o, BenchMode mode) {
   j["raycast_kernel"] = raycast_kernel_name;
   j["raycast_views"] = raycast_poses.size();
   j["raycast_pose_indexes"] = raycast_poses;
-  j["camera"] = {{"width", info.camera.width},       {"height", info.camera.height},
-                 {"fx", FloatValue(info.camera.fx)}, {"fy", FloatValue(info.camera.fy)},
-                 {"cx", FloatValue(info.camera.cx)}, {"cy", FloatValue(info.camera.cy)}};
+  j["camera"] = {{"width", info.camera.width},           {"height", info.camera.height},
+                 {"fx", ShortestDouble(info.camera.fx)}, {"fy", ShortestDouble(info.camera.fy)},
+                 {"cx", ShortestDouble(info.camera.cx)}, {"cy", ShortestDouble(info.camera.cy)}};
   j["vs_open3d"] = o.vs_open3d;
   j["machine"] = {{"nproc", Nproc()}, {"cpu_model", CpuModel()}};
   // The top level repeats the largest thread count's row.

@@ -118,7 +118,7 @@ int RunBenchMaps(const MapsOptions& o) {
   j["dataset"] = info.root;
   j["format"] = DatasetFormatName(info.format);
   j["resolution"] = o.resolution_m;
-  j["trunc_m"] = FloatValue(volume_params.trunc_m);
+  j["trunc_m"] = ShortestDouble(volume_params.trunc_m);
   j["min_depth_m"] = o.in.min_depth_m;
   j["max_depth_m"] = o.in.max_depth_m;
   j["frames"] = frames.size();

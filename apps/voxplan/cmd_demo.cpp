@@ -13,8 +13,10 @@
 #include "fusion/mesh_extract.h"
 #include "io/map_io.h"
 #include "io/mesh_io.h"
+#include "pipeline/fuse_dataset.h"
 #include "sim/demo_room.h"
 #include "sim/raycaster.h"
+#include "sim/rendered_dataset.h"
 
 namespace voxplan::cli {
 
@@ -65,24 +67,19 @@ int RunDemo(const DemoOptions& o) {
             << room.num_triangles() << " triangles), voxel " << o.voxel_size_m << " m, trunc "
             << trunc_m << " m, " << MaxThreads() << " threads\n";
 
-  std::vector<double> render_ms, integrate_ms;
+  // The frames are rendered as the pipeline loads them ("load" is the render time).
+  const RenderedDataset frames(**raycaster, camera, poses, "demo room");
+  std::vector<size_t> indices(poses.size());
+  for (size_t k = 0; k < indices.size(); ++k) indices[k] = k;
+  FuseParams fuse;
+  fuse.integrate = params;
   Progress progress("demo", poses.size());
-  for (size_t k = 0; k < poses.size(); ++k) {
-    const Pose3f T_W_C = poses[k].cast<float>();
-    const Stopwatch render_clock;
-    const RenderOutput frame = (*raycaster)->Render(camera, T_W_C);
-    render_ms.push_back(render_clock.ElapsedMs());
-    const Stopwatch integrate_clock;
-    Result<IntegrateStats> stats =
-        IntegrateFrame(frame.depth, frame.color, camera, T_W_C, params, volume);
-    integrate_ms.push_back(integrate_clock.ElapsedMs());
-    if (!stats.ok()) {
-      progress.Finish();
-      return Fail("frame " + std::to_string(k) + ": " + stats.status().message());
-    }
-    progress.Update(k + 1);
-  }
+  FuseObserver observer;
+  observer.progress = [&](size_t done, size_t) { progress.Update(done); };
+  observer.warning = [&](const std::string& message) { progress.Warn(message); };
+  Result<FuseReport> report = FuseDataset(frames, indices, fuse, volume, observer);
   progress.Finish();
+  if (!report.ok()) return Fail(report.status().message());
 
   const Stopwatch mesh_clock;
   const Mesh mesh = ExtractMesh(volume);
@@ -113,7 +110,8 @@ int RunDemo(const DemoOptions& o) {
   const bool rms_met = eval->accuracy_rms_m <= rms_target_m;
   const bool completeness_met = eval->completeness >= kCompletenessTarget;
 
-  const TimingSummary render_t = Summarize(render_ms), integrate_t = Summarize(integrate_ms);
+  const TimingSummary render_t = Summarize(report->load_ms),
+                      integrate_t = Summarize(report->integrate_ms);
   nlohmann::json j;
   j["command"] = "demo";
   j["frames"] = poses.size();
@@ -127,7 +125,7 @@ int RunDemo(const DemoOptions& o) {
   AddMapStats(j, volume);
   AddMeshStats(j, mesh, mesh_ms);
   j["eval_ms"] = RoundTo(eval_ms, 3);
-  j["threshold_m"] = FloatValue(eval_params.threshold_m);
+  j["threshold_m"] = ShortestDouble(eval_params.threshold_m);
   j["accuracy_mean_m"] = eval->accuracy_mean_m;
   j["accuracy_rms_m"] = eval->accuracy_rms_m;
   j["accuracy_median_m"] = eval->accuracy_median_m;

@@ -12,11 +12,12 @@
 #include "core/volume.h"
 #include "fusion/integrate.h"
 #include "fusion/mesh_extract.h"
-#include "fusion/tracking.h"
 #include "io/dataset.h"
+#include "io/frame_list.h"
 #include "io/map_io.h"
 #include "io/mesh_io.h"
 #include "io/tum_trajectory.h"
+#include "pipeline/fuse_dataset.h"
 
 namespace voxplan::cli {
 
@@ -44,13 +45,6 @@ struct FuseOptions {
   bool track = false;
   double photometric_weight = 0.0;
 };
-
-// Beyond this many, per-frame skip warnings collapse into one count at the end.
-constexpr int kMaxSkipWarnings = 5;
-
-bool AllZero(const DepthImage& depth) {
-  return std::none_of(depth.data.begin(), depth.data.end(), [](float z) { return z > 0.f; });
-}
 
 nlohmann::json OrNull(const std::string& path) {
   return path.empty() ? nlohmann::json(nullptr) : nlohmann::json(path);
@@ -92,99 +86,21 @@ int RunFuse(const FuseOptions& o) {
             << " m, trunc " << o.trunc_m << " m, " << MaxThreads() << " threads, kernel "
             << KernelName(ResolveKernel(params.kernel)) << std::endl;
 
-  std::vector<double> load_ms, integrate_ms, frame_ms;
-  nlohmann::json frame_list = nlohmann::json::array();
-  size_t skipped_no_pose = 0, skipped_empty = 0, frames_lost = 0;
-  std::vector<double> track_ms, trajectory_t;
-  std::vector<Pose3f> trajectory;
-  std::optional<FrameTracker> tracker;
-  bool tracker_started = false;
-  if (o.track) {
-    TrackingParams tracking;
-    tracking.photometric_weight = float(o.photometric_weight);
-    tracking.raycast.max_depth_m = float(o.in.max_depth_m);
-    tracking.raycast.min_depth_m = float(o.in.min_depth_m);
-    tracker.emplace(info.camera, tracking);
-  }
+  FuseParams fuse;
+  fuse.integrate = params;
+  fuse.track = o.track;
+  fuse.tracking.photometric_weight = float(o.photometric_weight);
+  fuse.tracking.raycast.max_depth_m = float(o.in.max_depth_m);
+  fuse.tracking.raycast.min_depth_m = float(o.in.min_depth_m);
   Progress progress("fuse", indices.size());
-  const Stopwatch loop_clock;
-  for (size_t k = 0; k < indices.size(); ++k) {
-    const size_t i = indices[k];
-    const Stopwatch load_clock;
-    Result<Frame> frame = dataset.Load(i);
-    const double load = load_clock.ElapsedMs();
-    if (!frame.ok()) {
-      progress.Finish();
-      return Fail("frame " + std::to_string(i) + ": " + frame.status().message());
-    }
-    if (AllZero(frame->depth)) {
-      if (++skipped_empty <= kMaxSkipWarnings) {
-        progress.Warn("frame " + std::to_string(i) + " (" + frame->depth_path +
-                      ") has no valid depth; skipped");
-      }
-      progress.Update(k + 1);
-      continue;
-    }
-    // The pose to integrate with: the dataset's, or with --track the tracker's (the first
-    // frame starts from the dataset pose when there is one, else the identity).
-    std::optional<Pose3f> T_W_C;
-    if (tracker && !tracker_started) {
-      T_W_C = frame->T_W_C ? Pose3f(frame->T_W_C->cast<float>()) : Pose3f::Identity();
-      tracker->Reset(*T_W_C);
-      tracker_started = true;
-    } else if (tracker) {
-      Result<TrackingResult> tracked = tracker->Track(frame->depth, frame->color, volume);
-      if (!tracked.ok()) {
-        progress.Finish();
-        return Fail(MessageNaming(tracked.status(), frame->depth_path));
-      }
-      track_ms.push_back(tracked->track_ms);
-      if (tracked->ok) {
-        T_W_C = tracked->T_W_C;
-        tracker->Accept(*T_W_C);
-      } else if (++frames_lost <= kMaxSkipWarnings) {
-        progress.Warn("frame " + std::to_string(i) + " (" + frame->depth_path +
-                      ") lost tracking (" + tracked->failure + "); not integrated");
-      }
-    } else if (frame->T_W_C) {
-      T_W_C = frame->T_W_C->cast<float>();
-    } else if (++skipped_no_pose <= kMaxSkipWarnings) {
-      progress.Warn("frame " + std::to_string(i) + " (" + frame->depth_path +
-                    ") has no pose; skipped");
-    }
-    if (T_W_C) {
-      const Stopwatch integrate_clock;
-      Result<IntegrateStats> stats =
-          IntegrateFrame(frame->depth, frame->color, info.camera, *T_W_C, params, volume);
-      const double integrate = integrate_clock.ElapsedMs();
-      if (!stats.ok()) {
-        progress.Finish();
-        return Fail(MessageNaming(stats.status(), frame->depth_path));
-      }
-      load_ms.push_back(load);
-      integrate_ms.push_back(integrate);
-      frame_ms.push_back(load + integrate);
-      trajectory_t.push_back(frame->timestamp);
-      trajectory.push_back(*T_W_C);
-      if (!o.frame_list_path.empty()) {
-        frame_list.push_back(
-            FrameListEntry(frame->depth_path, frame->color_path, T_W_C->matrix().cast<double>()));
-      }
-    }
-    progress.Update(k + 1);
-  }
+  FuseObserver observer;
+  observer.progress = [&](size_t done, size_t) { progress.Update(done); };
+  observer.warning = [&](const std::string& message) { progress.Warn(message); };
+  Result<FuseReport> fused = FuseDataset(dataset, indices, fuse, volume, observer);
   progress.Finish();
-  const double loop_s = loop_clock.ElapsedMs() / 1000.0;
-  if (skipped_no_pose > kMaxSkipWarnings) {
-    Warn(std::to_string(skipped_no_pose) + " frames in all had no pose and were skipped");
-  }
-  if (frames_lost > kMaxSkipWarnings) {
-    Warn(std::to_string(frames_lost) + " frames in all lost tracking and were not integrated");
-  }
-  if (skipped_empty > kMaxSkipWarnings) {
-    Warn(std::to_string(skipped_empty) + " frames in all had no valid depth and were skipped");
-  }
-  if (frame_ms.empty()) {
+  if (!fused.ok()) return Fail(fused.status().message());
+  const FuseReport& report = *fused;
+  if (report.frames.empty()) {
     return Fail("no frame was integrated (" + std::to_string(indices.size()) +
                 " selected, all skipped): " + o.in.dataset);
   }
@@ -205,34 +121,45 @@ int RunFuse(const FuseOptions& o) {
     if (Status s = SaveMap(volume, o.map_path); !s.ok()) return Fail(MessageNaming(s, o.map_path));
   }
   if (!o.trajectory_path.empty()) {
-    if (Status s = WriteTumTrajectory(o.trajectory_path, trajectory_t, trajectory); !s.ok())
+    std::vector<double> timestamps_s;
+    std::vector<Pose3f> poses;
+    for (const FusedFrame& f : report.frames) {
+      timestamps_s.push_back(f.timestamp_s);
+      poses.push_back(f.T_W_C);
+    }
+    if (Status s = WriteTumTrajectory(o.trajectory_path, timestamps_s, poses); !s.ok())
       return Fail(MessageNaming(s, o.trajectory_path));
   }
   if (!o.frame_list_path.empty()) {
     // Exactly the frames integrated, with the parameters, for reference runs of other
     // pipelines (bench/open3d_fusion.py) on identical input.
-    const nlohmann::json list = FrameList(info.camera, info.depth_scale, o.voxel_size_m, o.trunc_m,
-                                          o.in.min_depth_m, o.in.max_depth_m, frame_list);
-    if (Status s = WriteJsonFile(list, o.frame_list_path); !s.ok())
+    std::vector<FrameListEntry> entries;
+    for (const FusedFrame& f : report.frames)
+      entries.push_back({f.depth_path, f.color_path, f.T_W_C.matrix().cast<double>()});
+    const FrameListParams list{info.camera, info.depth_scale, o.voxel_size_m,
+                               o.trunc_m,   o.in.min_depth_m, o.in.max_depth_m};
+    if (Status s = WriteFrameList(o.frame_list_path, list, entries); !s.ok())
       return Fail(MessageNaming(s, o.frame_list_path));
   }
 
-  const TimingSummary load_t = Summarize(load_ms), integrate_t = Summarize(integrate_ms),
-                      frame_t = Summarize(frame_ms);
-  const size_t integrated = frame_ms.size();
+  const TimingSummary load_t = Summarize(report.load_ms),
+                      integrate_t = Summarize(report.integrate_ms),
+                      frame_t = Summarize(report.frame_ms);
+  const size_t integrated = report.frames.size();
+  const double loop_s = report.loop_s;
   nlohmann::json j;
   j["command"] = "fuse";
   j["dataset"] = o.in.dataset;
   j["format"] = DatasetFormatName(info.format);
   j["frames"] = integrated;
   j["frames_selected"] = indices.size();
-  j["frames_skipped"] = skipped_no_pose + skipped_empty;
-  j["frames_skipped_no_pose"] = skipped_no_pose;
+  j["frames_skipped"] = report.skipped_no_pose + report.skipped_no_depth;
+  j["frames_skipped_no_pose"] = report.skipped_no_pose;
   j["tracking"] = o.track;
-  j["frames_lost"] = frames_lost;
-  j["track_ms_median"] = RoundTo(Summarize(track_ms).median, 3);
+  j["frames_lost"] = report.frames_lost;
+  j["track_ms_median"] = RoundTo(Summarize(report.track_ms).median, 3);
   j["trajectory"] = OrNull(o.trajectory_path);
-  j["frames_skipped_no_depth"] = skipped_empty;
+  j["frames_skipped_no_depth"] = report.skipped_no_depth;
   j["voxel_size_m"] = o.voxel_size_m;
   j["trunc_m"] = o.trunc_m;
   j["min_depth_m"] = o.in.min_depth_m;
@@ -241,9 +168,9 @@ int RunFuse(const FuseOptions& o) {
   j["weighting"] = o.weighting;
   j["threads"] = MaxThreads();
   j["kernel"] = KernelName(ResolveKernel(params.kernel));
-  j["camera"] = {{"width", info.camera.width},       {"height", info.camera.height},
-                 {"fx", FloatValue(info.camera.fx)}, {"fy", FloatValue(info.camera.fy)},
-                 {"cx", FloatValue(info.camera.cx)}, {"cy", FloatValue(info.camera.cy)}};
+  j["camera"] = {{"width", info.camera.width},           {"height", info.camera.height},
+                 {"fx", ShortestDouble(info.camera.fx)}, {"fy", ShortestDouble(info.camera.fy)},
+                 {"cx", ShortestDouble(info.camera.cx)}, {"cy", ShortestDouble(info.camera.cy)}};
   j["depth_scale"] = info.depth_scale;
   j["integrate_ms_median"] = RoundTo(integrate_t.median, 3);
   j["integrate_ms_p90"] = RoundTo(integrate_t.p90, 3);

@@ -50,8 +50,9 @@ int DatasetInfoCommand(const InfoOptions& o) {
   j["root"] = info.root;
   j["format"] = DatasetFormatName(info.format);
   j["frames"] = info.num_frames;
-  j["camera"] = {{"width", c.width},       {"height", c.height},     {"fx", FloatValue(c.fx)},
-                 {"fy", FloatValue(c.fy)}, {"cx", FloatValue(c.cx)}, {"cy", FloatValue(c.cy)}};
+  j["camera"] = {{"width", c.width},           {"height", c.height},
+                 {"fx", ShortestDouble(c.fx)}, {"fy", ShortestDouble(c.fy)},
+                 {"cx", ShortestDouble(c.cx)}, {"cy", ShortestDouble(c.cy)}};
   j["intrinsics_source"] = info.intrinsics_source;
   j["depth_scale"] = info.depth_scale;
   j["pose_source"] = info.pose_source;
@@ -93,8 +94,8 @@ int MapInfoCommand(const InfoOptions& o) {
   j["kind"] = "map";
   j["path"] = o.path;
   j["version"] = header->version;
-  j["voxel_size_m"] = FloatValue(header->params.voxel_size_m);
-  j["trunc_m"] = FloatValue(header->params.trunc_m);
+  j["voxel_size_m"] = ShortestDouble(header->params.voxel_size_m);
+  j["trunc_m"] = ShortestDouble(header->params.trunc_m);
   AddMapStats(j, *volume);
   j["observed_voxels"] = observed;
   j["memory_bytes"] = volume->MemoryBytes();

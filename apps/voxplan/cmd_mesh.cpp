@@ -47,8 +47,8 @@ int RunMesh(const MeshOptions& o) {
   j["command"] = "mesh";
   j["map"] = o.map_path;
   j["out"] = o.out_path;
-  j["voxel_size_m"] = FloatValue(volume->voxel_size_m());
-  j["trunc_m"] = FloatValue(volume->trunc_m());
+  j["voxel_size_m"] = ShortestDouble(volume->voxel_size_m());
+  j["trunc_m"] = ShortestDouble(volume->trunc_m());
   j["min_weight"] = o.min_weight;
   j["threads"] = MaxThreads();
   j["load_ms"] = RoundTo(load_ms, 3);

@@ -123,10 +123,10 @@ int RunSimRender(const SimRenderOptions& o) {
   j["frames"] = summary->frames;
   j["camera"] = {{"width", width},
                  {"height", height},
-                 {"fx", FloatValue(options.camera.fx)},
-                 {"fy", FloatValue(options.camera.fy)},
-                 {"cx", FloatValue(options.camera.cx)},
-                 {"cy", FloatValue(options.camera.cy)}};
+                 {"fx", ShortestDouble(options.camera.fx)},
+                 {"fy", ShortestDouble(options.camera.fy)},
+                 {"cx", ShortestDouble(options.camera.cx)},
+                 {"cy", ShortestDouble(options.camera.cy)}};
   j["noise"] = options.noise;
   j["seed"] = o.seed;
   j["valid_depth_fraction"] = RoundTo(summary->valid_depth_fraction, 4);

@@ -141,10 +141,11 @@ int RunSimScene(const SimSceneOptions& o) {
   j["instances"] = world->instances.size();
   j["triangles"] = world->mesh.num_triangles();
   j["vertices"] = world->mesh.num_vertices();
-  j["floor_plan"] = {{"width", plan.width},
-                     {"height", plan.height},
-                     {"resolution_m", FloatValue(plan.resolution_m)},
-                     {"origin", {FloatValue(plan.origin_W.x()), FloatValue(plan.origin_W.y())}}};
+  j["floor_plan"] = {
+      {"width", plan.width},
+      {"height", plan.height},
+      {"resolution_m", ShortestDouble(plan.resolution_m)},
+      {"origin", {ShortestDouble(plan.origin_W.x()), ShortestDouble(plan.origin_W.y())}}};
   j["paths"] = written->paths;
   j["build_ms"] = RoundTo(build_ms, 1);
   j["write_ms"] = RoundTo(write_ms, 1);

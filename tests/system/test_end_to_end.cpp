@@ -14,6 +14,7 @@
 #include "fusion/integrate.h"
 #include "fusion/mesh_extract.h"
 #include "io/dataset.h"
+#include "pipeline/fuse_dataset.h"
 #include "sim/raycaster.h"
 #include "tests/support/test_support.h"
 
@@ -39,15 +40,16 @@ const FusedIcl& FuseIcl() {
     if (!dataset.ok()) return f;
     f.camera = (*dataset)->info().camera;
     f.volume = std::make_unique<TsdfVolume>(VolumeParams{0.02f, 0.08f});
-    for (size_t i = 0; i < 60; ++i) {
-      auto frame = (*dataset)->Load(i);
-      EXPECT_TRUE(frame.ok()) << frame.status().message();
-      if (!frame.ok() || !frame->T_W_C) continue;
-      auto stats = IntegrateFrame(frame->depth, frame->color, f.camera, frame->T_W_C->cast<float>(),
-                                  {}, *f.volume);
-      EXPECT_TRUE(stats.ok()) << stats.status().message();
-      if (i == 10 || i == 35 || i == 59) f.checked.push_back(std::move(*frame));
-    }
+    std::vector<size_t> indices(60);
+    for (size_t i = 0; i < indices.size(); ++i) indices[i] = i;
+    FuseObserver observer;
+    observer.integrated = [&](const Frame& frame, const Pose3f&, TsdfVolume&) {
+      if (frame.index == 10 || frame.index == 35 || frame.index == 59) f.checked.push_back(frame);
+      return Status::Ok();
+    };
+    Result<FuseReport> report = FuseDataset(**dataset, indices, {}, *f.volume, observer);
+    EXPECT_TRUE(report.ok()) << report.status().message();
+    EXPECT_EQ(f.checked.size(), 3u);
     return f;
   }();
   return fused;

@@ -1,0 +1,130 @@
+#include "pipeline/fuse_dataset.h"
+
+#include <algorithm>
+#include <memory>
+#include <optional>
+#include <stdexcept>
+
+#include "core/stopwatch.h"
+
+namespace voxplan {
+
+namespace {
+
+bool AllZero(const DepthImage& depth) {
+  return std::none_of(depth.data.begin(), depth.data.end(), [](float z) { return z > 0.f; });
+}
+
+// The status with the frame's file in front, unless the message already names it (a frame
+// without a file, such as a rendered one, is named by its index).
+Status Naming(const Status& status, const Frame& frame) {
+  const std::string name =
+      frame.depth_path.empty() ? "frame " + std::to_string(frame.index) : frame.depth_path;
+  if (status.message().find(name) != std::string::npos) return status;
+  return status.WithContext(name);
+}
+
+// Names the first few skipped frames of one kind, then counts the rest.
+class SkipCounter {
+ public:
+  SkipCounter(const FuseObserver& observer, int max_named, const char* what_in_all)
+      : observer_(observer), max_named_(size_t(std::max(max_named, 0))), what_(what_in_all) {}
+  void Skip(const Frame& frame, const std::string& why) {
+    if (++count_ <= max_named_ && observer_.warning)
+      observer_.warning("frame " + std::to_string(frame.index) + " (" + frame.depth_path + ") " +
+                        why);
+  }
+  void Finish() const {
+    if (count_ > max_named_ && observer_.warning)
+      observer_.warning(std::to_string(count_) + " frames in all " + what_);
+  }
+  size_t count() const { return count_; }
+
+ private:
+  const FuseObserver& observer_;
+  size_t max_named_;
+  const char* what_;
+  size_t count_ = 0;
+};
+
+}  // namespace
+
+Result<FuseReport> FuseDataset(const Dataset& dataset, const std::vector<size_t>& indices,
+                               const FuseParams& params, TsdfVolume& volume,
+                               const FuseObserver& observer) {
+  const DatasetInfo& info = dataset.info();
+  std::optional<FrameTracker> tracker;
+  if (params.track) {
+    try {
+      tracker.emplace(info.camera, params.tracking);
+    } catch (const std::invalid_argument& e) {
+      return InvalidArgument(std::string("tracking: ") + e.what());
+    }
+  }
+  bool tracker_started = false;
+
+  FuseReport report;
+  report.frames_selected = indices.size();
+  SkipCounter no_depth(observer, params.max_skip_warnings, "had no valid depth and were skipped");
+  SkipCounter no_pose(observer, params.max_skip_warnings, "had no pose and were skipped");
+  SkipCounter lost(observer, params.max_skip_warnings, "lost tracking and were not integrated");
+  const Stopwatch loop_clock;
+  for (size_t k = 0; k < indices.size(); ++k) {
+    const size_t i = indices[k];
+    const Stopwatch load_clock;
+    Result<Frame> frame = dataset.Load(i);
+    const double load_ms = load_clock.ElapsedMs();
+    if (!frame.ok()) return frame.status().WithContext("frame " + std::to_string(i));
+    if (AllZero(frame->depth)) {
+      no_depth.Skip(*frame, "has no valid depth; skipped");
+      if (observer.progress) observer.progress(k + 1, indices.size());
+      continue;
+    }
+    std::optional<Pose3f> T_W_C;
+    if (tracker && !tracker_started) {
+      T_W_C = frame->T_W_C ? Pose3f(frame->T_W_C->cast<float>()) : Pose3f::Identity();
+      tracker->Reset(*T_W_C);
+      tracker_started = true;
+    } else if (tracker) {
+      Result<TrackingResult> tracked = tracker->Track(frame->depth, frame->color, volume);
+      if (!tracked.ok()) return Naming(tracked.status(), *frame);
+      report.track_ms.push_back(tracked->track_ms);
+      if (tracked->ok) {
+        T_W_C = tracked->T_W_C;
+        tracker->Accept(*T_W_C);
+      } else {
+        lost.Skip(*frame, "lost tracking (" + tracked->failure + "); not integrated");
+      }
+    } else if (frame->T_W_C) {
+      T_W_C = frame->T_W_C->cast<float>();
+    } else {
+      no_pose.Skip(*frame, "has no pose; skipped");
+    }
+    if (T_W_C) {
+      const Stopwatch integrate_clock;
+      Result<IntegrateStats> stats =
+          IntegrateFrame(frame->depth, frame->color, info.camera, *T_W_C, params.integrate, volume);
+      const double integrate_ms = integrate_clock.ElapsedMs();
+      if (!stats.ok()) return Naming(stats.status(), *frame);
+      report.load_ms.push_back(load_ms);
+      report.integrate_ms.push_back(integrate_ms);
+      report.frame_ms.push_back(load_ms + integrate_ms);
+      report.frames.push_back(
+          {frame->index, frame->timestamp, *T_W_C, frame->depth_path, frame->color_path});
+      if (observer.integrated) {
+        if (Status s = observer.integrated(*frame, *T_W_C, volume); !s.ok()) return s;
+      }
+    }
+    if (observer.progress) observer.progress(k + 1, indices.size());
+  }
+  report.loop_s = loop_clock.ElapsedS();
+  no_pose.Finish();
+  lost.Finish();
+  no_depth.Finish();
+  report.skipped_no_pose = no_pose.count();
+  report.skipped_no_depth = no_depth.count();
+  report.frames_lost = lost.count();
+  return report;
+}
+
+}  // namespace voxplan

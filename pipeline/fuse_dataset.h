@@ -1,0 +1,64 @@
+#pragma once
+// A whole fusion run over a dataset: the frame loop that `voxplan fuse`, `voxplan bench`, the
+// demo and the tests share. Per selected frame: load, skip a frame without valid depth, choose
+// the pose (the dataset's, or with tracking the tracker's: the first frame starts from the
+// dataset pose, else the identity; a frame that loses tracking is not integrated), integrate,
+// record. Counts and timings come back in the report; progress and warnings go to the
+// observer, never printed here.
+#include <cstddef>
+#include <functional>
+#include <string>
+#include <vector>
+
+#include "core/pose.h"
+#include "core/status.h"
+#include "core/volume.h"
+#include "fusion/integrate.h"
+#include "fusion/tracking.h"
+#include "io/dataset.h"
+
+namespace voxplan {
+
+struct FuseParams {
+  IntegrateParams integrate;
+  // Estimate poses by frame-to-model ICP instead of reading them from the dataset.
+  bool track = false;
+  TrackingParams tracking;
+  // Per kind of skipped frame (no depth, no pose, lost tracking): this many frames are named in
+  // a warning each; beyond, one warning at the end gives the count.
+  int max_skip_warnings = 5;
+};
+
+struct FusedFrame {
+  size_t index = 0;  // in the dataset
+  double timestamp_s = 0.0;
+  Pose3f T_W_C = Pose3f::Identity();  // the pose it was integrated at
+  std::string depth_path, color_path;
+};
+
+struct FuseReport {
+  std::vector<FusedFrame> frames;  // the integrated frames, in order
+  size_t frames_selected = 0;
+  size_t skipped_no_pose = 0, skipped_no_depth = 0;
+  size_t frames_lost = 0;  // tracking only: lost, not integrated
+  // Per integrated frame: decoding, integration, their sum; per tracked frame: tracking.
+  std::vector<double> load_ms, integrate_ms, frame_ms, track_ms;
+  double loop_s = 0.0;  // the whole loop, skipped frames included
+};
+
+struct FuseObserver {
+  std::function<void(size_t done, size_t total)> progress;  // after every selected frame
+  std::function<void(const std::string& message)> warning;
+  // After each integrated frame, outside the integration timing (e.g. an incremental mesher);
+  // a failure stops the run with that status.
+  std::function<Status(const Frame& frame, const Pose3f& T_W_C, TsdfVolume& volume)> integrated;
+};
+
+// Fuses dataset frames `indices` (in that order) into `volume`. Fails, naming the frame and its
+// file, when a frame cannot be loaded, integrated or tracked; an invalid camera for tracking is
+// refused. An empty report (no frame integrated) is not a failure: the caller decides.
+Result<FuseReport> FuseDataset(const Dataset& dataset, const std::vector<size_t>& indices,
+                               const FuseParams& params, TsdfVolume& volume,
+                               const FuseObserver& observer = {});
+
+}  // namespace voxplan
