@@ -1,7 +1,6 @@
 #include "fusion/integrate.h"
 
 #include <algorithm>
-#include <chrono>
 #include <cmath>
 #include <cstring>
 #include <limits>
@@ -9,15 +8,12 @@
 #include <string>
 
 #include "core/parallel.h"
+#include "core/stopwatch.h"
 #include "fusion/integrate_kernel.h"
 
 namespace voxplan {
 
 namespace {
-
-double MsSince(std::chrono::steady_clock::time_point t0) {
-  return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
-}
 
 // Visits the blocks a world-space segment passes through (Amanatides & Woo traversal in block
 // units), so the band along one pixel ray costs a few steps instead of many point samples.
@@ -368,7 +364,7 @@ Result<IntegrateStats> IntegrateFrame(const DepthImage& depth, const ColorImage&
   if (!T_W_C.matrix().allFinite()) return InvalidArgument("camera pose has NaN or infinite values");
 
   IntegrateStats stats;
-  auto t0 = std::chrono::steady_clock::now();
+  Stopwatch clock;
   size_t valid_pixels = 0;
   std::vector<BlockIndex> band =
       CollectBlocks(depth, camera, T_W_C, params, volume.params(), params.carve_free_space,
@@ -385,9 +381,9 @@ Result<IntegrateStats> IntegrateFrame(const DepthImage& depth, const ColorImage&
     ++stats.blocks_allocated;
   }
   stats.blocks_in_band = band.size();
-  stats.allocate_ms = MsSince(t0);
+  stats.allocate_ms = clock.ElapsedMs();
 
-  t0 = std::chrono::steady_clock::now();
+  clock.Restart();
   internal::FrameView f;
   f.depth = depth.data.data();
   f.color = (params.integrate_color && !color.empty()) ? color.data.data() : nullptr;
@@ -426,7 +422,7 @@ Result<IntegrateStats> IntegrateFrame(const DepthImage& depth, const ColorImage&
       kernel(f, band[i], *blocks[i]);
     }
   });
-  stats.update_ms = MsSince(t0);
+  stats.update_ms = clock.ElapsedMs();
   if (params.carve_free_space) {
     // Branch-free, so it vectorises.
     uint32_t valid = 0;

@@ -3,7 +3,6 @@
 #include <Eigen/Cholesky>
 #include <Eigen/Eigenvalues>
 #include <algorithm>
-#include <chrono>
 #include <cmath>
 #include <limits>
 #include <memory>
@@ -12,6 +11,7 @@
 #include <vector>
 
 #include "core/parallel.h"
+#include "core/stopwatch.h"
 
 namespace voxplan {
 
@@ -28,12 +28,6 @@ constexpr float kNormalDepthGate = 0.05f;
 
 using Vec6d = Eigen::Matrix<double, 6, 1>;
 using Mat6d = Eigen::Matrix<double, 6, 6>;
-using Clock = std::chrono::steady_clock;
-
-double MsSince(Clock::time_point t0) {
-  return std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
-}
-
 // A pixel with a vertex and a normal, packed so the ICP loop streams through memory.
 struct InputPoint {
   Eigen::Vector3f p_C;
@@ -533,14 +527,14 @@ Result<TrackingResult> FrameTracker::Track(const DepthImage& depth, const ColorI
                            std::to_string(camera_.width) + "x" + std::to_string(camera_.height));
   if (!color.empty() && (color.width != depth.width || color.height != depth.height))
     return InvalidArgument("Track: colour and depth sizes differ");
-  const auto t_start = Clock::now();
+  const Stopwatch total_clock;
   TrackingResult result;
   const Pose3f T_W_C_pred = Predict();
   result.T_W_C = T_W_C_pred;
   const bool photometric = params_.photometric_weight > 0.f && !color.empty();
 
   // Input pyramid.
-  auto t0 = Clock::now();
+  Stopwatch clock;
   std::array<InputLevel, kLevels>& levels = workspace_->levels;
   levels[0].camera = camera_;
   FilterDepth(depth, params_, workspace_->masked_depth, levels[0].depth);
@@ -555,22 +549,22 @@ Result<TrackingResult> FrameTracker::Track(const DepthImage& depth, const ColorI
     if (!photometric) level.intensity = Image<float>();
     BuildPoints(level, l == 0 ? params_.finest_level_stride : 1, workspace_->bands);
   }
-  result.filter_ms = MsSince(t0);
+  result.filter_ms = clock.ElapsedMs();
   const auto finish = [&](std::string failure) {
     result.ok = failure.empty();
     result.failure = std::move(failure);
     if (!result.ok) result.T_W_C = T_W_C_pred;
-    result.track_ms = MsSince(t_start);
+    result.track_ms = total_clock.ElapsedMs();
     return result;
   };
   if (levels[0].valid_pixels == 0) return finish("no valid depth in the frame");
 
-  t0 = Clock::now();
+  clock.Restart();
   const ModelImages model = BuildModel(volume, LevelCamera(camera_, params_.model_level),
                                        T_W_C_pred, params_, photometric);
-  result.raycast_ms = MsSince(t0);
+  result.raycast_ms = clock.ElapsedMs();
 
-  t0 = Clock::now();
+  clock.Restart();
   const Pose3f T_C_W_pred = T_W_C_pred.inverse();
   Pose3d T_W_C = T_W_C_pred.cast<double>();
   NormalEquations last;
@@ -581,7 +575,7 @@ Result<TrackingResult> FrameTracker::Track(const DepthImage& depth, const ColorI
       ++result.iterations;
       ++result.level_iterations[size_t(l)];
       if (last.inliers < kMinCorrespondences) {
-        result.icp_ms = MsSince(t0);
+        result.icp_ms = clock.ElapsedMs();
         return finish("too few correspondences with the model (" + std::to_string(last.inliers) +
                       " at level " + std::to_string(l) + ")");
       }
@@ -592,14 +586,14 @@ Result<TrackingResult> FrameTracker::Track(const DepthImage& depth, const ColorI
       // the finest level decides.
       if (!(result.condition_number <= params_.max_condition_number)) {
         if (l > 0) break;
-        result.icp_ms = MsSince(t0);
+        result.icp_ms = clock.ElapsedMs();
         return finish("degenerate geometry: condition number " +
                       std::to_string(result.condition_number) + " > " +
                       std::to_string(params_.max_condition_number));
       }
       const Vec6d xi = last.H.ldlt().solve(-last.g);
       if (!xi.allFinite()) {
-        result.icp_ms = MsSince(t0);
+        result.icp_ms = clock.ElapsedMs();
         return finish("non-finite Gauss-Newton update");
       }
       T_W_C = ExpSe3(xi) * T_W_C;
@@ -608,7 +602,7 @@ Result<TrackingResult> FrameTracker::Track(const DepthImage& depth, const ColorI
       if (xi.norm() < params_.min_update * float(1 << l)) break;
     }
   }
-  result.icp_ms = MsSince(t0);
+  result.icp_ms = clock.ElapsedMs();
   T_W_C.linear() = Eigen::Quaterniond(T_W_C.linear()).normalized().toRotationMatrix();
 
   // Statistics of the finest level's last system (one step before the final pose).

@@ -1,14 +1,8 @@
 #include "planning/integrate_planning.h"
 
-#include <chrono>
+#include "core/stopwatch.h"
 
 namespace voxplan {
-
-namespace {
-double MsBetween(std::chrono::steady_clock::time_point a, std::chrono::steady_clock::time_point b) {
-  return std::chrono::duration<double, std::milli>(b - a).count();
-}
-}  // namespace
 
 Result<PlanningFrameStats> IntegratePlanningFrame(const DepthImage& depth, const ColorImage& color,
                                                   const LabelImage* labels,
@@ -22,23 +16,23 @@ Result<PlanningFrameStats> IntegratePlanningFrame(const DepthImage& depth, const
     return InvalidArgument("label image size differs from the depth image size");
   params.carve_free_space = true;
   PlanningFrameStats stats;
-  const auto t0 = std::chrono::steady_clock::now();
+  const Stopwatch total_clock;
+  Stopwatch clock;
   Result<IntegrateStats> integrated = IntegrateFrame(depth, color, camera, T_W_C, params, volume);
   if (!integrated.ok()) return integrated.status();
   stats.integrate = std::move(integrated).value();
-  const auto t1 = std::chrono::steady_clock::now();
+  stats.integrate_ms = clock.ElapsedMs();
+  clock.Restart();
   stats.map = map.Update(stats.integrate.touched_blocks);
-  const auto t2 = std::chrono::steady_clock::now();
+  stats.map_ms = clock.ElapsedMs();
+  clock.Restart();
   if (with_labels) {
     VOXPLAN_RETURN_IF_ERROR(map.FuseLabels(depth, *labels, camera, T_W_C,
                                            stats.integrate.touched_blocks, params.min_depth_m,
                                            params.max_depth_m));
   }
-  const auto t3 = std::chrono::steady_clock::now();
-  stats.integrate_ms = MsBetween(t0, t1);
-  stats.map_ms = MsBetween(t1, t2);
-  stats.labels_ms = MsBetween(t2, t3);
-  stats.total_ms = MsBetween(t0, t3);
+  stats.labels_ms = clock.ElapsedMs();
+  stats.total_ms = total_clock.ElapsedMs();
   stats.revision = map.revision();
   return stats;
 }

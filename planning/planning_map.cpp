@@ -1,13 +1,13 @@
 #include "planning/planning_map.h"
 
 #include <algorithm>
-#include <chrono>
 #include <cmath>
 #include <limits>
 #include <map>
 #include <stdexcept>
 
 #include "core/parallel.h"
+#include "core/stopwatch.h"
 
 #if defined(__SSE2__)
 #include <emmintrin.h>
@@ -190,7 +190,7 @@ PlanningUpdateStats PlanningMap::Rebuild() {
 }
 
 PlanningUpdateStats PlanningMap::UpdateBlocks(const std::vector<BlockIndex>& touched) {
-  const auto t0 = std::chrono::steady_clock::now();
+  const Stopwatch clock;
   PlanningUpdateStats stats;
   stats.blocks_touched = touched.size();
   // Phase 1 (touched blocks): free / occupied masks from the TSDF. Sidecars are created or
@@ -257,8 +257,7 @@ PlanningUpdateStats PlanningMap::UpdateBlocks(const std::vector<BlockIndex>& tou
   });
   if (changed || !jobs.empty()) revision_ = revision;
   stats.blocks_updated = jobs.size();
-  stats.update_ms =
-      std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+  stats.update_ms = clock.ElapsedMs();
   return stats;
 }
 

@@ -1,11 +1,11 @@
 #include "sim/dataset_writer.h"
 
-#include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
 
 #include "core/parallel.h"
+#include "core/stopwatch.h"
 #include "io/file_util.h"
 #include "io/image_io.h"
 
@@ -14,11 +14,6 @@ namespace voxplan {
 namespace {
 
 namespace fs = std::filesystem;
-
-double MsSince(std::chrono::steady_clock::time_point start) {
-  return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start)
-      .count();
-}
 
 std::string FrameName(size_t i) {
   char name[32];
@@ -102,12 +97,12 @@ Result<SimDatasetSummary> RenderSimDataset(const MeshRaycaster& raycaster,
   std::string labels_txt = "# instance label images (16-bit ids, 0 = none)\n# timestamp filename\n";
   size_t valid = 0, total = 0;
   for (size_t i = 0; i < trajectory.T_W_C.size(); ++i) {
-    auto start = std::chrono::steady_clock::now();
+    Stopwatch clock;
     const Pose3f T_W_C = trajectory.T_W_C[i].cast<float>();
     RenderOutput out = raycaster.Render(options.camera, T_W_C, render);
-    summary.render_ms.push_back(MsSince(start));
+    summary.render_ms.push_back(clock.ElapsedMs());
 
-    start = std::chrono::steady_clock::now();
+    clock.Restart();
     if (options.noise) {
       auto noisy =
           ApplyKinectNoise(out.depth, out.normals_C, options.camera, options.noise_params, i);
@@ -116,10 +111,10 @@ Result<SimDatasetSummary> RenderSimDataset(const MeshRaycaster& raycaster,
     }
     for (float z : out.depth.data) valid += z > 0.f;
     total += out.depth.data.size();
-    summary.noise_ms.push_back(MsSince(start));
+    summary.noise_ms.push_back(clock.ElapsedMs());
 
     // The three images of a frame are encoded in parallel (PNG compression dominates).
-    start = std::chrono::steady_clock::now();
+    clock.Restart();
     const std::string name = FrameName(i);
     Status status[3];
     ParallelFor(3, 1, [&](size_t begin, size_t end) {
@@ -134,7 +129,7 @@ Result<SimDatasetSummary> RenderSimDataset(const MeshRaycaster& raycaster,
       }
     });
     for (const Status& s : status) VOXPLAN_RETURN_IF_ERROR(s);
-    summary.write_ms.push_back(MsSince(start));
+    summary.write_ms.push_back(clock.ElapsedMs());
 
     const std::string t = Stamp(trajectory.timestamps_s[i]);
     depth_txt += t + " depth/" + name + "\n";

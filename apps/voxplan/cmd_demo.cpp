@@ -38,6 +38,24 @@ constexpr double kThresholdVoxels = 2.0;
 constexpr double kTruncVoxels = 4.0;
 constexpr int kVisibilityPoseStride = 2;
 
+// Completeness counts the surface the trajectory could observe: the same camera, poses and
+// depth range that produced the frames. Every other pose suffices; it halves the renders.
+Result<MeshEvalResult> ScoreDemoMesh(const Mesh& mesh, const Mesh& room,
+                                     const MeshRaycaster& raycaster, const PinholeCamera& camera,
+                                     const std::vector<Pose3d>& poses,
+                                     const IntegrateParams& params, MeshEvalParams eval_params) {
+  VisibilityParams visibility;
+  visibility.min_depth_m = params.min_depth_m;
+  visibility.max_depth_m = params.max_depth_m;
+  visibility.pose_stride = kVisibilityPoseStride;
+  Result<PointSetFilter> observable = ObservableSurfaceFilter(raycaster, camera, poses, visibility);
+  if (!observable.ok()) return observable.status().WithContext("visibility");
+  eval_params.ground_truth_filter = *observable;
+  Result<MeshEvalResult> eval = EvaluateMesh(mesh, room, eval_params);
+  if (!eval.ok()) return eval.status().WithContext("evaluation failed");
+  return eval;
+}
+
 int RunDemo(const DemoOptions& o) {
   std::error_code ec;
   fs::create_directories(o.out_dir, ec);
@@ -93,18 +111,9 @@ int RunDemo(const DemoOptions& o) {
   eval_params.threshold_m = float(kThresholdVoxels * o.voxel_size_m);
   eval_params.seed = 1;
   const Stopwatch eval_clock;
-  // Completeness counts the surface the trajectory could observe: the same camera, poses and
-  // depth range that produced the frames. Every other pose suffices; it halves the renders.
-  VisibilityParams visibility;
-  visibility.min_depth_m = params.min_depth_m;
-  visibility.max_depth_m = params.max_depth_m;
-  visibility.pose_stride = kVisibilityPoseStride;
-  Result<PointSetFilter> observable =
-      ObservableSurfaceFilter(**raycaster, camera, poses, visibility);
-  if (!observable.ok()) return Fail("visibility: " + observable.status().message());
-  eval_params.ground_truth_filter = *observable;
-  Result<MeshEvalResult> eval = EvaluateMesh(mesh, room, eval_params);
-  if (!eval.ok()) return Fail("evaluation failed: " + eval.status().message());
+  Result<MeshEvalResult> eval =
+      ScoreDemoMesh(mesh, room, **raycaster, camera, poses, params, eval_params);
+  if (!eval.ok()) return Fail(eval.status().message());
   const double eval_ms = eval_clock.ElapsedMs();
   const double rms_target_m = kRmsTargetVoxels * o.voxel_size_m;
   const bool rms_met = eval->accuracy_rms_m <= rms_target_m;

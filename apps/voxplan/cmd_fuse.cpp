@@ -50,6 +50,101 @@ nlohmann::json OrNull(const std::string& path) {
   return path.empty() ? nlohmann::json(nullptr) : nlohmann::json(path);
 }
 
+// The mesh (extracted here), map, trajectory and frame list that were asked for.
+Status WriteFuseOutputs(const FuseOptions& o, const DatasetInfo& info, const TsdfVolume& volume,
+                        const FuseReport& report, Mesh* mesh, double* mesh_ms) {
+  if (!o.mesh_path.empty()) {
+    const Stopwatch mesh_clock;
+    MeshParams mesh_params;
+    mesh_params.min_weight = float(o.mesh_min_weight);
+    *mesh = ExtractMesh(volume, mesh_params);
+    *mesh_ms = mesh_clock.ElapsedMs();
+    if (Status s = WriteMesh(*mesh, o.mesh_path); !s.ok()) {
+      return Status(s.code(), MessageNaming(s, o.mesh_path));
+    }
+  }
+  if (!o.map_path.empty()) {
+    if (Status s = SaveMap(volume, o.map_path); !s.ok())
+      return Status(s.code(), MessageNaming(s, o.map_path));
+  }
+  if (!o.trajectory_path.empty()) {
+    std::vector<double> timestamps_s;
+    std::vector<Pose3f> poses;
+    for (const FusedFrame& f : report.frames) {
+      timestamps_s.push_back(f.timestamp_s);
+      poses.push_back(f.T_W_C);
+    }
+    if (Status s = WriteTumTrajectory(o.trajectory_path, timestamps_s, poses); !s.ok())
+      return Status(s.code(), MessageNaming(s, o.trajectory_path));
+  }
+  if (!o.frame_list_path.empty()) {
+    // Exactly the frames integrated, with the parameters, for reference runs of other
+    // pipelines (bench/open3d_fusion.py) on identical input.
+    std::vector<FrameListEntry> entries;
+    for (const FusedFrame& f : report.frames)
+      entries.push_back({f.depth_path, f.color_path, f.T_W_C.matrix().cast<double>()});
+    const FrameListParams list{info.camera, info.depth_scale, o.voxel_size_m,
+                               o.trunc_m,   o.in.min_depth_m, o.in.max_depth_m};
+    if (Status s = WriteFrameList(o.frame_list_path, list, entries); !s.ok())
+      return Status(s.code(), MessageNaming(s, o.frame_list_path));
+  }
+
+  return Status::Ok();
+}
+
+// The stats object: the same on the last stdout line and in --stats.
+nlohmann::json FuseStats(const FuseOptions& o, const DatasetInfo& info,
+                         const IntegrateParams& params, const FuseReport& report,
+                         const TsdfVolume& volume, const Mesh& mesh, double mesh_ms) {
+  const TimingSummary load_t = Summarize(report.load_ms),
+                      integrate_t = Summarize(report.integrate_ms),
+                      frame_t = Summarize(report.frame_ms);
+  const size_t integrated = report.frames.size();
+  const double loop_s = report.loop_s;
+  nlohmann::json j;
+  j["command"] = "fuse";
+  j["dataset"] = o.in.dataset;
+  j["format"] = DatasetFormatName(info.format);
+  j["frames"] = integrated;
+  j["frames_selected"] = report.frames_selected;
+  j["frames_skipped"] = report.skipped_no_pose + report.skipped_no_depth;
+  j["frames_skipped_no_pose"] = report.skipped_no_pose;
+  j["tracking"] = o.track;
+  j["frames_lost"] = report.frames_lost;
+  j["track_ms_median"] = RoundTo(Summarize(report.track_ms).median, 3);
+  j["trajectory"] = OrNull(o.trajectory_path);
+  j["frames_skipped_no_depth"] = report.skipped_no_depth;
+  j["voxel_size_m"] = o.voxel_size_m;
+  j["trunc_m"] = o.trunc_m;
+  j["min_depth_m"] = o.in.min_depth_m;
+  j["max_depth_m"] = o.in.max_depth_m;
+  j["max_weight"] = o.max_weight;
+  j["weighting"] = o.weighting;
+  j["threads"] = MaxThreads();
+  j["kernel"] = KernelName(ResolveKernel(params.kernel));
+  j["camera"] = {{"width", info.camera.width},           {"height", info.camera.height},
+                 {"fx", ShortestDouble(info.camera.fx)}, {"fy", ShortestDouble(info.camera.fy)},
+                 {"cx", ShortestDouble(info.camera.cx)}, {"cy", ShortestDouble(info.camera.cy)}};
+  j["depth_scale"] = info.depth_scale;
+  j["integrate_ms_median"] = RoundTo(integrate_t.median, 3);
+  j["integrate_ms_p90"] = RoundTo(integrate_t.p90, 3);
+  j["integrate_ms_mean"] = RoundTo(integrate_t.mean, 3);
+  j["load_ms_median"] = RoundTo(load_t.median, 3);
+  j["load_ms_p90"] = RoundTo(load_t.p90, 3);
+  j["frame_ms_median"] = RoundTo(frame_t.median, 3);
+  j["frame_ms_p90"] = RoundTo(frame_t.p90, 3);
+  j["loop_s"] = RoundTo(loop_s, 3);
+  // Throughput of the whole frame loop (decode + integrate + skipped frames).
+  j["fps"] = RoundTo(loop_s > 0 ? double(integrated) / loop_s : 0.0, 2);
+  AddMapStats(j, volume);
+  AddMeshStats(j, mesh, mesh_ms);
+  j["mesh"] = OrNull(o.mesh_path);
+  j["map"] = OrNull(o.map_path);
+  j["stats"] = OrNull(o.stats_path);
+  j["peak_rss_mb"] = PeakRssMb();
+  return j;
+}
+
 int RunFuse(const FuseOptions& o) {
   // Everything the arguments alone can refuse is refused before the dataset is read.
   if (o.trunc_m < o.voxel_size_m) {
@@ -107,87 +202,10 @@ int RunFuse(const FuseOptions& o) {
 
   Mesh mesh;
   double mesh_ms = 0.0;
-  if (!o.mesh_path.empty()) {
-    const Stopwatch mesh_clock;
-    MeshParams mesh_params;
-    mesh_params.min_weight = float(o.mesh_min_weight);
-    mesh = ExtractMesh(volume, mesh_params);
-    mesh_ms = mesh_clock.ElapsedMs();
-    if (Status s = WriteMesh(mesh, o.mesh_path); !s.ok()) {
-      return Fail(MessageNaming(s, o.mesh_path));
-    }
-  }
-  if (!o.map_path.empty()) {
-    if (Status s = SaveMap(volume, o.map_path); !s.ok()) return Fail(MessageNaming(s, o.map_path));
-  }
-  if (!o.trajectory_path.empty()) {
-    std::vector<double> timestamps_s;
-    std::vector<Pose3f> poses;
-    for (const FusedFrame& f : report.frames) {
-      timestamps_s.push_back(f.timestamp_s);
-      poses.push_back(f.T_W_C);
-    }
-    if (Status s = WriteTumTrajectory(o.trajectory_path, timestamps_s, poses); !s.ok())
-      return Fail(MessageNaming(s, o.trajectory_path));
-  }
-  if (!o.frame_list_path.empty()) {
-    // Exactly the frames integrated, with the parameters, for reference runs of other
-    // pipelines (bench/open3d_fusion.py) on identical input.
-    std::vector<FrameListEntry> entries;
-    for (const FusedFrame& f : report.frames)
-      entries.push_back({f.depth_path, f.color_path, f.T_W_C.matrix().cast<double>()});
-    const FrameListParams list{info.camera, info.depth_scale, o.voxel_size_m,
-                               o.trunc_m,   o.in.min_depth_m, o.in.max_depth_m};
-    if (Status s = WriteFrameList(o.frame_list_path, list, entries); !s.ok())
-      return Fail(MessageNaming(s, o.frame_list_path));
-  }
-
-  const TimingSummary load_t = Summarize(report.load_ms),
-                      integrate_t = Summarize(report.integrate_ms),
-                      frame_t = Summarize(report.frame_ms);
+  if (Status s = WriteFuseOutputs(o, info, volume, report, &mesh, &mesh_ms); !s.ok())
+    return Fail(s.message());
+  const nlohmann::json j = FuseStats(o, info, params, report, volume, mesh, mesh_ms);
   const size_t integrated = report.frames.size();
-  const double loop_s = report.loop_s;
-  nlohmann::json j;
-  j["command"] = "fuse";
-  j["dataset"] = o.in.dataset;
-  j["format"] = DatasetFormatName(info.format);
-  j["frames"] = integrated;
-  j["frames_selected"] = indices.size();
-  j["frames_skipped"] = report.skipped_no_pose + report.skipped_no_depth;
-  j["frames_skipped_no_pose"] = report.skipped_no_pose;
-  j["tracking"] = o.track;
-  j["frames_lost"] = report.frames_lost;
-  j["track_ms_median"] = RoundTo(Summarize(report.track_ms).median, 3);
-  j["trajectory"] = OrNull(o.trajectory_path);
-  j["frames_skipped_no_depth"] = report.skipped_no_depth;
-  j["voxel_size_m"] = o.voxel_size_m;
-  j["trunc_m"] = o.trunc_m;
-  j["min_depth_m"] = o.in.min_depth_m;
-  j["max_depth_m"] = o.in.max_depth_m;
-  j["max_weight"] = o.max_weight;
-  j["weighting"] = o.weighting;
-  j["threads"] = MaxThreads();
-  j["kernel"] = KernelName(ResolveKernel(params.kernel));
-  j["camera"] = {{"width", info.camera.width},           {"height", info.camera.height},
-                 {"fx", ShortestDouble(info.camera.fx)}, {"fy", ShortestDouble(info.camera.fy)},
-                 {"cx", ShortestDouble(info.camera.cx)}, {"cy", ShortestDouble(info.camera.cy)}};
-  j["depth_scale"] = info.depth_scale;
-  j["integrate_ms_median"] = RoundTo(integrate_t.median, 3);
-  j["integrate_ms_p90"] = RoundTo(integrate_t.p90, 3);
-  j["integrate_ms_mean"] = RoundTo(integrate_t.mean, 3);
-  j["load_ms_median"] = RoundTo(load_t.median, 3);
-  j["load_ms_p90"] = RoundTo(load_t.p90, 3);
-  j["frame_ms_median"] = RoundTo(frame_t.median, 3);
-  j["frame_ms_p90"] = RoundTo(frame_t.p90, 3);
-  j["loop_s"] = RoundTo(loop_s, 3);
-  // Throughput of the whole frame loop (decode + integrate + skipped frames).
-  j["fps"] = RoundTo(loop_s > 0 ? double(integrated) / loop_s : 0.0, 2);
-  AddMapStats(j, volume);
-  AddMeshStats(j, mesh, mesh_ms);
-  j["mesh"] = OrNull(o.mesh_path);
-  j["map"] = OrNull(o.map_path);
-  j["stats"] = OrNull(o.stats_path);
-  j["peak_rss_mb"] = PeakRssMb();
   if (!o.stats_path.empty()) {
     if (Status s = WriteJsonFile(j, o.stats_path); !s.ok()) {
       return Fail(MessageNaming(s, o.stats_path));

@@ -1,19 +1,19 @@
 #pragma once
 // What the host's three plan-call files share: the memory behind the opaque C handles and the
 // small conversions both the C table and the validation use. Not for use outside plugins/host.
-#include <chrono>
 #include <cmath>
 #include <initializer_list>
 #include <string>
 #include <vector>
 
+#include "core/stopwatch.h"
 #include "plugins/host/plugin_host.h"
 
 // Host memory handed to the plugin lives here until the call returns.
 struct vp_world {
   const voxplan::PlannerWorld* world = nullptr;
   vp_call_info call{};
-  std::chrono::steady_clock::time_point start;
+  voxplan::Stopwatch clock;  // since the call began
   std::vector<voxplan::PlanLogEntry>* log = nullptr;
 
   mutable bool have_frontier = false, have_surface = false, have_instances = false;
@@ -59,7 +59,7 @@ inline bool AllFinite(std::initializer_list<float> values) {
 
 inline double ElapsedS(const vp_world* w) {
   if (w == nullptr) return 0.0;
-  return std::chrono::duration<double>(std::chrono::steady_clock::now() - w->start).count();
+  return w->clock.ElapsedS();
 }
 
 // Checks what the plugin returned against the world; drops and logs what cannot be executed.

@@ -1,6 +1,5 @@
 // One plan() call: the C handles set up over a PlannerWorld, the plugin's plan() timed, and its
 // output validated into a PlanResult.
-#include <chrono>
 #include <cstdio>
 #include <exception>
 #include <string>
@@ -66,7 +65,7 @@ Result<PlanResult> LoadedPlanner::Plan(const PlannerWorld& world, const PlanRequ
   vp_plan_output out;
   out.result = &result;
 
-  w.start = std::chrono::steady_clock::now();
+  w.clock.Restart();  // the plugin's elapsed time counts from here
   const vp_status status = api_.plan(instance_, &w, &out);
   result.elapsed_ms = ElapsedS(&w) * 1e3;
   if (status != VP_OK) {
