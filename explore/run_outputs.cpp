@@ -1,0 +1,220 @@
+// The artefacts of one exploration experiment (explore/run_outputs.h): the metrics object, the
+// logs and tables, and the top-down picture. Moved out of `voxplan explore` as they were.
+#include "explore/run_outputs.h"
+
+#include <algorithm>
+#include <cmath>
+#include <filesystem>
+#include <nlohmann/json.hpp>
+#include <sstream>
+#include <utility>
+#include <vector>
+
+#include "io/file_util.h"
+#include "io/image_io.h"
+#include "io/mesh_io.h"
+#include "viewer_offscreen/top_down.h"
+
+namespace voxplan {
+
+namespace {
+
+namespace fs = std::filesystem;
+using nlohmann::json;
+
+// As the CLI rounds every number it reports (apps/voxplan/cli_common.h).
+double RoundTo(double value, int decimals) {
+  const double scale = std::pow(10.0, decimals);
+  return std::round(value * scale) / scale;
+}
+
+std::string Num(double v) {
+  std::ostringstream s;
+  s << v;
+  return s.str();
+}
+
+// Median and 90th percentile, linear interpolation between closest ranks; 0 when empty.
+std::pair<double, double> MedianAndP90(std::vector<double> values_ms) {
+  if (values_ms.empty()) return {0.0, 0.0};
+  std::sort(values_ms.begin(), values_ms.end());
+  auto quantile = [&](double q) {
+    const double pos = q * double(values_ms.size() - 1);
+    const size_t lo = size_t(std::floor(pos));
+    const size_t hi = std::min(lo + 1, values_ms.size() - 1);
+    return values_ms[lo] + (pos - double(lo)) * (values_ms[hi] - values_ms[lo]);
+  };
+  return {quantile(0.5), quantile(0.9)};
+}
+
+// `status` with `path` in front unless its message already names it.
+Status Naming(const Status& status, const std::string& path) {
+  if (status.message().find(path) != std::string::npos) return status;
+  return status.WithContext(path);
+}
+
+std::string InFolder(const std::string& out_dir, const char* name) {
+  return (fs::path(out_dir) / name).string();
+}
+
+Status WriteText(const std::string& text, const std::string& path) {
+  return WriteAtomically(path,
+                         [&](const std::string& tmp) { return WriteStringToFile(tmp, text); });
+}
+
+Status WriteLines(const std::vector<std::string>& lines, const std::string& path) {
+  std::string text;
+  for (const std::string& l : lines) text += l + "\n";
+  return WriteText(text, path);
+}
+
+json MetricsObject(const ExploreRunParams& params, const ExploreRunReport& report) {
+  const ExploreResult& r = report.loop;
+  const MeshEvalResult& quality = report.quality;
+  const RunMetrics& metrics = report.metrics;
+  std::vector<double> plan_ms;
+  for (const PlanCallRecord& c : r.plan_calls) plan_ms.push_back(c.elapsed_ms);
+  const auto [plan_ms_median, plan_ms_p90] = MedianAndP90(plan_ms);
+
+  json m;
+  m["scene"] = params.scene;
+  m["planner"] = report.planner_name;
+  m["robots"] = params.robots;
+  m["seed"] = params.explore.seed;
+  m["completeness"] = RoundTo(quality.completeness, 4);
+  m["completeness_all"] = RoundTo(quality.completeness_all, 4);
+  m["completeness_reference"] =
+      report.observable_reference
+          ? "ground-truth surface observable from a sim tour of the reachable floor (" +
+                Num(params.explore.robot.explorer.max_range_m) +
+                " m range), samples within 5 cm of the final mesh"
+          : "whole ground-truth surface, samples within 5 cm of the final mesh";
+  m["accuracy_rms_m"] = RoundTo(quality.accuracy_rms_m, 4);
+  m["accuracy_mean_m"] = RoundTo(quality.accuracy_mean_m, 4);
+  json per_robot = json::array();
+  for (const RobotRunMetrics& rm : metrics.robots) per_robot.push_back(RoundTo(rm.distance_m, 3));
+  m["distance_per_robot_m"] = per_robot;
+  m["distance_total_m"] = RoundTo(metrics.distance_total_m, 3);
+  m["distance_per_area"] = RoundTo(metrics.distance_per_area, 4);
+  m["scene_area_m2"] = RoundTo(report.scene_area_m2, 2);
+  m["load_balance_cov"] = RoundTo(metrics.load_balance_cov, 4);
+  m["time_s"] = RoundTo(r.time_s, 2);
+  m["idle_time_s"] = RoundTo(metrics.idle_time_total_s, 2);
+  m["time_load_balance"] = RoundTo(metrics.time_load_balance, 4);
+  m["coverage"] = r.series.empty() ? 0.0 : RoundTo(r.series.back().coverage, 4);
+  m["plan_calls"] = r.plan_calls.size();
+  m["plan_ms_median"] = RoundTo(plan_ms_median, 3);  // wall time: varies run to run
+  m["plan_ms_p90"] = RoundTo(plan_ms_p90, 3);
+  m["plans_over_budget"] = r.over_budget_calls;
+  m["rejected_tasks"] = r.rejected_tasks;
+  m["failed_tasks"] = r.failed_tasks;
+  m["failed_plan_calls"] = r.failed_plans;
+  m["frames_fused"] = r.frames_fused;
+  m["terminated"] = r.terminated;
+  m["done_reason"] = r.done_reason;
+  return m;
+}
+
+// plan_calls.csv: one row per call; elapsed_ms and over_budget are wall time.
+std::vector<std::string> PlanCallRows(const std::vector<PlanCallRecord>& plan_calls) {
+  std::vector<std::string> calls = {
+      "call,t,event,event_robot,tasks,rejections,done,elapsed_ms,"
+      "over_budget,diagnostics"};
+  for (const PlanCallRecord& c : plan_calls) {
+    size_t tasks = 0;
+    for (size_t n : c.tasks_per_robot) tasks += n;
+    std::ostringstream line;
+    line << c.call_index << "," << c.t_s << "," << PlanEventName(c.event) << "," << c.event_robot
+         << "," << tasks << "," << c.rejections << "," << (c.done ? 1 : 0) << ","
+         << RoundTo(c.elapsed_ms, 3) << "," << (c.over_budget ? 1 : 0) << ",";
+    for (size_t k = 0; k < c.diagnostics.size(); ++k)
+      line << (k ? ";" : "") << c.diagnostics[k].first << "=" << c.diagnostics[k].second;
+    calls.push_back(line.str());
+  }
+  return calls;
+}
+
+// Top-down picture: the final floor map, paths, start and end marks, task views.
+Status WriteTopDown(const ExploreResult& r, const std::string& path) {
+  TopDownRaster raster;
+  const FloorGeometry& g = r.floor->geometry();
+  raster.origin_W = g.origin_cell.cast<float>() * g.cell_size_m;
+  raster.resolution_m = g.cell_size_m;
+  raster.classes = Image<uint8_t>(g.width, g.height);
+  for (int y = 0; y < g.height; ++y)
+    for (int x = 0; x < g.width; ++x) {
+      const FloorCell c = r.floor->At(x, y);
+      raster.classes.at(x, y) = uint8_t(c == FloorCell::kFree       ? TopDownClass::kFree
+                                        : c == FloorCell::kObstacle ? TopDownClass::kObstacle
+                                        : c == FloorCell::kFrontier ? TopDownClass::kFrontier
+                                                                    : TopDownClass::kUnknown);
+    }
+  std::vector<TopDownPath> paths;
+  for (size_t i = 0; i < r.tracks.size(); ++i) {
+    TopDownPath tp;
+    for (const RobotSample& s : r.tracks[i].samples) {
+      const Eigen::Vector2f p(float(s.x_m), float(s.y_m));
+      if (tp.points_W.empty() || (tp.points_W.back() - p).norm() > 1e-3f) tp.points_W.push_back(p);
+    }
+    for (const PlannerTask& t : r.task_views[i])
+      tp.views.push_back({t.position_m, t.theta_rad + t.camera_yaw_rad});
+    paths.push_back(std::move(tp));
+  }
+  if (g.width > 0) {
+    Result<ColorImage> picture = RenderTopDown(raster, paths);
+    if (!picture.ok()) return picture.status();
+    if (Status s = WriteColorPng(path, *picture); !s.ok()) return Naming(s, path);
+  }
+  return Status();
+}
+
+}  // namespace
+
+Status WriteRunMesh(const Mesh& mesh, const std::string& out_dir) {
+  const std::string mesh_path = InFolder(out_dir, "mesh.ply");
+  if (Status s = WriteMesh(mesh, mesh_path); !s.ok()) return Naming(s, mesh_path);
+  return Status();
+}
+
+std::string RunMetricsJson(const ExploreRunParams& params, const ExploreRunReport& report) {
+  return MetricsObject(params, report).dump();
+}
+
+std::string RunSummaryJson(const ExploreRunParams& params, const ExploreRunReport& report) {
+  json j = MetricsObject(params, report);
+  const ExploreTimings& t = report.loop.timings;
+  j["setup_ms"] = RoundTo(report.setup_ms, 1);
+  j["tour_frames"] = report.tour_frames;
+  j["render_ms"] = RoundTo(t.render_ms, 1);
+  j["noise_ms"] = RoundTo(t.noise_ms, 1);
+  j["fuse_ms"] = RoundTo(t.fuse_ms, 1);
+  j["floor_ms"] = RoundTo(t.floor_ms, 1);
+  j["plan_ms_total"] = RoundTo(t.plan_ms, 1);
+  j["series_ms"] = RoundTo(t.series_ms, 1);
+  j["loop_ms"] = RoundTo(t.total_ms, 1);
+  j["eval_ms"] = RoundTo(report.eval_ms, 1);
+  return j.dump();
+}
+
+Status WriteRunOutputs(const ExploreRunParams& params, const ExploreRunReport& report) {
+  const ExploreResult& r = report.loop;
+  std::string path = InFolder(params.out_dir, "metrics.json");
+  VOXPLAN_RETURN_IF_ERROR(WriteText(MetricsObject(params, report).dump(2) + "\n", path));
+
+  path = InFolder(params.out_dir, "run_log.csv");
+  if (Status s = WriteRunLog(r.tracks, path); !s.ok()) return Naming(s, path);
+  std::vector<RunTimePoint> series = r.series;
+  for (RunTimePoint& p : series) {
+    // Distance from the log, so the series and the metrics agree.
+    p.distance_total_m = DistanceUpTo(r.tracks, p.t_s);
+  }
+  path = InFolder(params.out_dir, "timeseries.csv");
+  if (Status s = WriteRunTimeSeriesCsv(series, path); !s.ok()) return Naming(s, path);
+  path = InFolder(params.out_dir, "plan_log.txt");
+  if (Status s = WriteLines(r.plan_log, path); !s.ok()) return Naming(s, path);
+  path = InFolder(params.out_dir, "plan_calls.csv");
+  if (Status s = WriteLines(PlanCallRows(r.plan_calls), path); !s.ok()) return Naming(s, path);
+  return WriteTopDown(r, InFolder(params.out_dir, "topdown.png"));
+}
+
+}  // namespace voxplan

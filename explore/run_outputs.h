@@ -1,0 +1,34 @@
+#pragma once
+// The artefacts of one exploration experiment (explore/explore_run.h) in its output folder, in
+// formats scripts/explore-suite and the tests read back:
+//   mesh.ply        the final mesh of the fused map
+//   metrics.json    completeness (see completeness_reference), accuracy, distances, balance,
+//                   times, plan calls, termination; all but plan_ms_* repeat for a seed
+//   timeseries.csv  coverage, completeness (every 30 s, volume estimate), distance vs time
+//   run_log.csv     every robot's poses and status (eval/eval_run.h format)
+//   topdown.png     the final floor map, each robot's path, start / end marks, reached views
+//   plan_log.txt    rejected tasks, failed tasks and plans, the plugin's messages
+//   plan_calls.csv  one row per plan call with its wall time and the plugin's diagnostics
+// Every error names the file it could not write. The report as JSON is here too, beside
+// metrics.json.
+#include <string>
+
+#include "core/mesh.h"
+#include "core/status.h"
+#include "explore/explore_run.h"
+
+namespace voxplan {
+
+// mesh.ply, written as soon as the mesh exists (before the evaluation).
+Status WriteRunMesh(const Mesh& mesh, const std::string& out_dir);
+
+// metrics.json's object as one line of JSON (keys sorted).
+std::string RunMetricsJson(const ExploreRunParams& params, const ExploreRunReport& report);
+// The same plus the wall-time breakdown (setup_ms, tour_frames, render_ms, noise_ms, fuse_ms,
+// floor_ms, plan_ms_total, series_ms, loop_ms, eval_ms): a run's summary line.
+std::string RunSummaryJson(const ExploreRunParams& params, const ExploreRunReport& report);
+
+// Everything but mesh.ply into params.out_dir.
+Status WriteRunOutputs(const ExploreRunParams& params, const ExploreRunReport& report);
+
+}  // namespace voxplan

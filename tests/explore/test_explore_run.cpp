@@ -1,0 +1,172 @@
+// One exploration experiment through the library (explore/explore_run.h): a short greedy run on
+// a small apartment writes every artefact, and metrics.json agrees with the report and the logs;
+// a bad request is refused before the output folder exists, a failing run is not a refusal.
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <fstream>
+#include <memory>
+#include <nlohmann/json.hpp>
+#include <string>
+#include <vector>
+
+#include "explore/explore_run.h"
+#include "explore/run_outputs.h"
+#include "tests/support/test_support.h"
+
+namespace voxplan {
+namespace {
+
+namespace fs = std::filesystem;
+
+std::unique_ptr<LoadedPlanner> Greedy() {
+  Result<std::unique_ptr<LoadedPlanner>> planner = LoadPlanner(
+      VOXPLAN_EXPLORE_TEST_PLANNER, {.config_json = "{}", .seed = 5, .search_path = {}});
+  EXPECT_TRUE(planner.ok()) << planner.status().message();
+  return planner.ok() ? std::move(planner).value() : nullptr;
+}
+
+// 60 simulated seconds, coarse, two robots: a few seconds of wall time.
+ExploreRunParams ShortRun(const fs::path& out) {
+  ExploreRunParams p;
+  p.scene = "apartment:size=S,seed=1";
+  p.robots = 2;
+  p.explore.voxel_size_m = 0.1f;
+  p.explore.image_width = 160;
+  p.explore.image_height = 120;
+  p.explore.max_time_s = 60.0;
+  p.explore.seed = 5;
+  p.explore.progress_interval_s = 10.0;
+  p.eval_samples_per_m2 = 50.0;
+  p.out_dir = out.string();
+  return p;
+}
+
+std::vector<std::string> Lines(const fs::path& path) {
+  std::ifstream in(path);
+  std::vector<std::string> lines;
+  for (std::string line; std::getline(in, line);) lines.push_back(line);
+  return lines;
+}
+
+TEST(ExploreRun, ShortRunWritesEveryArtefactAndItsMetricsAgree) {
+  test::TempDir dir("explore_run");
+  std::unique_ptr<LoadedPlanner> planner = Greedy();
+  ASSERT_NE(planner, nullptr);
+  std::vector<std::string> started;
+  size_t progress_calls = 0;
+  ExploreRunObserver observer;
+  observer.started = [&](const std::string& world_name) { started.push_back(world_name); };
+  observer.progress = [&](const ExploreProgress&) { ++progress_calls; };
+  bool refused = true;
+  const ExploreRunParams params = ShortRun(dir / "out");
+  Result<ExploreRunReport> report = RunExploreExperiment(params, *planner, observer, &refused);
+  ASSERT_TRUE(report.ok()) << report.status().message();
+  EXPECT_FALSE(refused);
+  ASSERT_EQ(started.size(), 1u);
+  EXPECT_EQ(started[0], report->world_name);
+  EXPECT_GE(progress_calls, 1u);
+
+  for (const char* f : {"mesh.ply", "metrics.json", "timeseries.csv", "run_log.csv", "topdown.png",
+                        "plan_log.txt", "plan_calls.csv"})
+    EXPECT_TRUE(fs::is_regular_file(dir / "out" / f)) << f;
+  EXPECT_GT(fs::file_size(dir / "out" / "mesh.ply"), 1000u);
+  EXPECT_GT(fs::file_size(dir / "out" / "topdown.png"), 1000u);
+
+  // The report: a reconstructed surface, judged against the tour-observable ground truth.
+  const ExploreResult& loop = report->loop;
+  EXPECT_EQ(report->planner_name, "greedy");
+  EXPECT_GT(report->mesh.num_triangles(), 0u);
+  EXPECT_TRUE(report->observable_reference);
+  EXPECT_GT(report->tour_frames, 0u);
+  EXPECT_GT(report->quality.completeness, 0.0);
+  EXPECT_LE(report->quality.completeness, 1.0);
+  ASSERT_EQ(report->metrics.robots.size(), 2u);
+  EXPECT_GT(report->metrics.distance_total_m, 0.0);
+  EXPECT_GT(report->scene_area_m2, 20.0);
+  EXPECT_FALSE(loop.plan_calls.empty());
+  EXPECT_LE(loop.time_s, 60.0 + 1.0);  // the last robot step may overrun
+
+  // metrics.json holds the report's metrics object, and says what the report says; the summary
+  // adds the wall-time breakdown.
+  std::ifstream metrics_file(dir / "out" / "metrics.json");
+  const nlohmann::json m = nlohmann::json::parse(metrics_file);
+  EXPECT_EQ(m, nlohmann::json::parse(RunMetricsJson(params, *report)));
+  nlohmann::json summary = nlohmann::json::parse(RunSummaryJson(params, *report));
+  EXPECT_EQ(summary["tour_frames"], report->tour_frames);
+  for (const char* key : {"setup_ms", "tour_frames", "render_ms", "noise_ms", "fuse_ms", "floor_ms",
+                          "plan_ms_total", "series_ms", "loop_ms", "eval_ms"})
+    EXPECT_EQ(summary.erase(key), 1u) << key;
+  EXPECT_EQ(summary, m);
+  EXPECT_EQ(m["scene"], "apartment:size=S,seed=1");
+  EXPECT_EQ(m["planner"], "greedy");
+  EXPECT_EQ(m["robots"], 2);
+  EXPECT_EQ(m["seed"], 5);
+  EXPECT_EQ(m["plan_calls"], loop.plan_calls.size());
+  EXPECT_EQ(m["frames_fused"], loop.frames_fused);
+  EXPECT_EQ(m["terminated"], loop.terminated);
+  EXPECT_EQ(m["distance_per_robot_m"].size(), 2u);
+  EXPECT_NEAR(m["completeness"].get<double>(), report->quality.completeness, 5e-5);
+  EXPECT_NEAR(m["distance_total_m"].get<double>(), report->metrics.distance_total_m, 5e-4);
+  EXPECT_NE(m["completeness_reference"].get<std::string>().find("sim tour"), std::string::npos);
+
+  // The tables: a header and one row per plan call; every robot's poses in the run log.
+  EXPECT_EQ(Lines(dir / "out" / "plan_calls.csv").size(), loop.plan_calls.size() + 1);
+  size_t samples = 0;
+  for (const RobotTrack& t : loop.tracks) samples += t.samples.size();
+  EXPECT_GT(Lines(dir / "out" / "run_log.csv").size(), samples / 2);
+  EXPECT_GE(Lines(dir / "out" / "timeseries.csv").size(), 2u);
+}
+
+TEST(ExploreRun, RefusesABadRequestBeforeTheOutputFolderExists) {
+  test::TempDir dir("explore_run_refused");
+  std::unique_ptr<LoadedPlanner> planner = Greedy();
+  ASSERT_NE(planner, nullptr);
+  ExploreRunParams spec = ShortRun(dir / "spec");
+  spec.scene = "apartment:size=X";
+  ExploreRunParams missing = ShortRun(dir / "missing");
+  missing.scene = (dir / "no_such_scene.ply").string();
+  ExploreRunParams blocked = ShortRun(dir / "blocked");
+  blocked.robots = 1;
+  blocked.starts = {{-50.f, -50.f}};  // outside the apartment
+  for (const ExploreRunParams& p : {spec, missing, blocked}) {
+    bool refused = false;
+    Result<ExploreRunReport> report = RunExploreExperiment(p, *planner, {}, &refused);
+    ASSERT_FALSE(report.ok()) << p.out_dir;
+    EXPECT_TRUE(refused) << report.status().message();
+    EXPECT_FALSE(fs::exists(p.out_dir)) << p.out_dir;
+  }
+
+  // A scene where the robots do not fit is the run's failure, not a bad request.
+  ExploreRunParams crowded = ShortRun(dir / "crowded");
+  crowded.robots = 40;
+  bool refused = true;
+  Result<ExploreRunReport> report = RunExploreExperiment(crowded, *planner, {}, &refused);
+  ASSERT_FALSE(report.ok());
+  EXPECT_FALSE(refused);
+  EXPECT_NE(report.status().message().find("apartment:size=S,seed=1"), std::string::npos)
+      << report.status().message();
+}
+
+TEST(ExploreRun, ParsesApartmentSpecsAndStarts) {
+  Result<ApartmentParams> a = ParseApartmentSpec("apartment:size=L,seed=7");
+  ASSERT_TRUE(a.ok()) << a.status().message();
+  EXPECT_EQ(a->size, ApartmentSize::kL);
+  EXPECT_EQ(a->seed, 7u);
+  Result<ApartmentParams> plain = ParseApartmentSpec("apartment");
+  ASSERT_TRUE(plain.ok());
+  EXPECT_EQ(plain->size, ApartmentSize::kM);
+  EXPECT_EQ(ParseApartmentSpec("scene.ply").status().code(), StatusCode::kNotFound);
+  EXPECT_EQ(ParseApartmentSpec("apartments").status().code(), StatusCode::kNotFound);
+  EXPECT_EQ(ParseApartmentSpec("apartment:seed=-1x").status().code(), StatusCode::kInvalidArgument);
+
+  Result<std::vector<Eigen::Vector2f>> s = ParseStarts("1,2;-3.5,4");
+  ASSERT_TRUE(s.ok()) << s.status().message();
+  ASSERT_EQ(s->size(), 2u);
+  EXPECT_EQ((*s)[1], Eigen::Vector2f(-3.5f, 4.f));
+  EXPECT_FALSE(ParseStarts("1,2;x").ok());
+  EXPECT_FALSE(ParseStarts("1,2,3").ok());
+}
+
+}  // namespace
+}  // namespace voxplan
