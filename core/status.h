@@ -31,6 +31,10 @@ class [[nodiscard]] Status {
   Status WithContext(const std::string& context) const {
     return ok() ? *this : Status(code_, context + ": " + message_);
   }
+  // The same, with `path` in front unless the message already names it.
+  Status Naming(const std::string& path) const {
+    return message_.find(path) != std::string::npos ? *this : WithContext(path);
+  }
 
  private:
   StatusCode code_ = StatusCode::kOk;

@@ -2,7 +2,6 @@
 // evaluation and the artefacts (explore/explore_run.h). Moved out of `voxplan explore` as it was.
 #include "explore/explore_run.h"
 
-#include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
@@ -10,6 +9,7 @@
 #include <memory>
 #include <sstream>
 
+#include "core/stopwatch.h"
 #include "eval/visibility.h"
 #include "explore/run_outputs.h"
 #include "fusion/mesh_extract.h"
@@ -23,23 +23,6 @@ namespace voxplan {
 namespace {
 
 namespace fs = std::filesystem;
-
-class Stopwatch {
- public:
-  double ElapsedMs() const {
-    return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start_)
-        .count();
-  }
-
- private:
-  std::chrono::steady_clock::time_point start_ = std::chrono::steady_clock::now();
-};
-
-// `status` with `path` in front unless its message already names it.
-Status Naming(const Status& status, const std::string& path) {
-  if (status.message().find(path) != std::string::npos) return status;
-  return status.WithContext(path);
-}
 
 // The world params.scene names; *refused for a malformed apartment spec or a missing file.
 Result<World> LoadScene(const ExploreRunParams& params, bool* refused) {
@@ -58,7 +41,7 @@ Result<World> LoadScene(const ExploreRunParams& params, bool* refused) {
     }
     world = LoadWorld(params.scene, params.scene_load);
   }
-  if (!world.ok()) return Naming(world.status(), params.scene);
+  if (!world.ok()) return world.status().Naming(params.scene);
   return world;
 }
 
@@ -119,7 +102,7 @@ Status Evaluate(const ExploreRunParams& params, const World& world, const FloorP
   if (filter) ep.ground_truth_filter = filter;
   if (report.mesh.num_triangles() > 0) {
     Result<MeshEvalResult> q = EvaluateMesh(report.mesh, world.mesh, ep);
-    if (!q.ok()) return Naming(q.status(), params.scene);
+    if (!q.ok()) return q.status().Naming(params.scene);
     report.quality = *q;
   }
   Result<RunMetrics> metrics = EvaluateRun(report.loop.tracks, {.scene_area_m2 = FloorArea(plan)});
@@ -201,7 +184,7 @@ Result<ExploreRunReport> RunExploreExperiment(const ExploreRunParams& params,
   Result<World> world = LoadScene(params, refused);
   if (!world.ok()) return world.status();
   Result<FloorPlan> plan = RasterizeFloorPlan(*world);
-  if (!plan.ok()) return Naming(plan.status(), params.scene);
+  if (!plan.ok()) return plan.status().Naming(params.scene);
 
   const ExploreParams& explore = params.explore;
   if (Status s = explore.Validate(); !s.ok()) {
@@ -212,7 +195,7 @@ Result<ExploreRunReport> RunExploreExperiment(const ExploreRunParams& params,
   if (starts.empty()) {
     Result<std::vector<Eigen::Vector2f>> chosen =
         ChooseStarts(*plan, world->rooms, params.robots, explore.robot.radius_m);
-    if (!chosen.ok()) return Naming(chosen.status(), params.scene);
+    if (!chosen.ok()) return chosen.status().Naming(params.scene);
     starts = *chosen;
   } else if (Status s = CheckStarts(*plan, starts, explore.robot.radius_m); !s.ok()) {
     *refused = true;
@@ -225,13 +208,13 @@ Result<ExploreRunReport> RunExploreExperiment(const ExploreRunParams& params,
   // Ground truth for completeness: the observable surface, sampled once for the time series.
   ExploreRunReport report;
   Result<std::unique_ptr<MeshRaycaster>> gt_raycaster = MeshRaycaster::Create(*world);
-  if (!gt_raycaster.ok()) return Naming(gt_raycaster.status(), params.scene);
+  if (!gt_raycaster.ok()) return gt_raycaster.status().Naming(params.scene);
   Result<PointSetFilter> filter =
       TourFilter(*world, *plan, **gt_raycaster, explore, &report.tour_frames);
-  if (!filter.ok()) return Naming(filter.status(), params.scene);
+  if (!filter.ok()) return filter.status().Naming(params.scene);
   Result<std::vector<Eigen::Vector3f>> probe_points =
       ProbePoints(world->mesh, *filter, explore.seed);
-  if (!probe_points.ok()) return Naming(probe_points.status(), params.scene);
+  if (!probe_points.ok()) return probe_points.status().Naming(params.scene);
   report.setup_ms = clock.ElapsedMs();
   report.world_name = world->name;
   report.planner_name = planner.name();

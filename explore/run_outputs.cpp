@@ -10,6 +10,7 @@
 #include <utility>
 #include <vector>
 
+#include "core/summary.h"
 #include "io/file_util.h"
 #include "io/image_io.h"
 #include "io/mesh_io.h"
@@ -22,35 +23,10 @@ namespace {
 namespace fs = std::filesystem;
 using nlohmann::json;
 
-// As the CLI rounds every number it reports (apps/voxplan/cli_common.h).
-double RoundTo(double value, int decimals) {
-  const double scale = std::pow(10.0, decimals);
-  return std::round(value * scale) / scale;
-}
-
 std::string Num(double v) {
   std::ostringstream s;
   s << v;
   return s.str();
-}
-
-// Median and 90th percentile, linear interpolation between closest ranks; 0 when empty.
-std::pair<double, double> MedianAndP90(std::vector<double> values_ms) {
-  if (values_ms.empty()) return {0.0, 0.0};
-  std::sort(values_ms.begin(), values_ms.end());
-  auto quantile = [&](double q) {
-    const double pos = q * double(values_ms.size() - 1);
-    const size_t lo = size_t(std::floor(pos));
-    const size_t hi = std::min(lo + 1, values_ms.size() - 1);
-    return values_ms[lo] + (pos - double(lo)) * (values_ms[hi] - values_ms[lo]);
-  };
-  return {quantile(0.5), quantile(0.9)};
-}
-
-// `status` with `path` in front unless its message already names it.
-Status Naming(const Status& status, const std::string& path) {
-  if (status.message().find(path) != std::string::npos) return status;
-  return status.WithContext(path);
 }
 
 std::string InFolder(const std::string& out_dir, const char* name) {
@@ -74,7 +50,7 @@ json MetricsObject(const ExploreRunParams& params, const ExploreRunReport& repor
   const RunMetrics& metrics = report.metrics;
   std::vector<double> plan_ms;
   for (const PlanCallRecord& c : r.plan_calls) plan_ms.push_back(c.elapsed_ms);
-  const auto [plan_ms_median, plan_ms_p90] = MedianAndP90(plan_ms);
+  const TimingSummary plan_summary = Summarize(plan_ms);
 
   json m;
   m["scene"] = params.scene;
@@ -103,8 +79,8 @@ json MetricsObject(const ExploreRunParams& params, const ExploreRunReport& repor
   m["time_load_balance"] = RoundTo(metrics.time_load_balance, 4);
   m["coverage"] = r.series.empty() ? 0.0 : RoundTo(r.series.back().coverage, 4);
   m["plan_calls"] = r.plan_calls.size();
-  m["plan_ms_median"] = RoundTo(plan_ms_median, 3);  // wall time: varies run to run
-  m["plan_ms_p90"] = RoundTo(plan_ms_p90, 3);
+  m["plan_ms_median"] = RoundTo(plan_summary.median, 3);  // wall time: varies run to run
+  m["plan_ms_p90"] = RoundTo(plan_summary.p90, 3);
   m["plans_over_budget"] = r.over_budget_calls;
   m["rejected_tasks"] = r.rejected_tasks;
   m["failed_tasks"] = r.failed_tasks;
@@ -163,7 +139,7 @@ Status WriteTopDown(const ExploreResult& r, const std::string& path) {
   if (g.width > 0) {
     Result<ColorImage> picture = RenderTopDown(raster, paths);
     if (!picture.ok()) return picture.status();
-    if (Status s = WriteColorPng(path, *picture); !s.ok()) return Naming(s, path);
+    if (Status s = WriteColorPng(path, *picture); !s.ok()) return s.Naming(path);
   }
   return Status();
 }
@@ -172,7 +148,7 @@ Status WriteTopDown(const ExploreResult& r, const std::string& path) {
 
 Status WriteRunMesh(const Mesh& mesh, const std::string& out_dir) {
   const std::string mesh_path = InFolder(out_dir, "mesh.ply");
-  if (Status s = WriteMesh(mesh, mesh_path); !s.ok()) return Naming(s, mesh_path);
+  if (Status s = WriteMesh(mesh, mesh_path); !s.ok()) return s.Naming(mesh_path);
   return Status();
 }
 
@@ -202,18 +178,18 @@ Status WriteRunOutputs(const ExploreRunParams& params, const ExploreRunReport& r
   VOXPLAN_RETURN_IF_ERROR(WriteText(MetricsObject(params, report).dump(2) + "\n", path));
 
   path = InFolder(params.out_dir, "run_log.csv");
-  if (Status s = WriteRunLog(r.tracks, path); !s.ok()) return Naming(s, path);
+  if (Status s = WriteRunLog(r.tracks, path); !s.ok()) return s.Naming(path);
   std::vector<RunTimePoint> series = r.series;
   for (RunTimePoint& p : series) {
     // Distance from the log, so the series and the metrics agree.
     p.distance_total_m = DistanceUpTo(r.tracks, p.t_s);
   }
   path = InFolder(params.out_dir, "timeseries.csv");
-  if (Status s = WriteRunTimeSeriesCsv(series, path); !s.ok()) return Naming(s, path);
+  if (Status s = WriteRunTimeSeriesCsv(series, path); !s.ok()) return s.Naming(path);
   path = InFolder(params.out_dir, "plan_log.txt");
-  if (Status s = WriteLines(r.plan_log, path); !s.ok()) return Naming(s, path);
+  if (Status s = WriteLines(r.plan_log, path); !s.ok()) return s.Naming(path);
   path = InFolder(params.out_dir, "plan_calls.csv");
-  if (Status s = WriteLines(PlanCallRows(r.plan_calls), path); !s.ok()) return Naming(s, path);
+  if (Status s = WriteLines(PlanCallRows(r.plan_calls), path); !s.ok()) return s.Naming(path);
   return WriteTopDown(r, InFolder(params.out_dir, "topdown.png"));
 }
 

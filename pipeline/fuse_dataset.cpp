@@ -18,10 +18,8 @@ bool AllZero(const DepthImage& depth) {
 // The status with the frame's file in front, unless the message already names it (a frame
 // without a file, such as a rendered one, is named by its index).
 Status Naming(const Status& status, const Frame& frame) {
-  const std::string name =
-      frame.depth_path.empty() ? "frame " + std::to_string(frame.index) : frame.depth_path;
-  if (status.message().find(name) != std::string::npos) return status;
-  return status.WithContext(name);
+  return status.Naming(frame.depth_path.empty() ? "frame " + std::to_string(frame.index)
+                                                : frame.depth_path);
 }
 
 // Names the first few skipped frames of one kind, then counts the rest.

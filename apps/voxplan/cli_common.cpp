@@ -106,8 +106,7 @@ int Fail(const std::string& message, int exit_code) {
 void Warn(const std::string& message) { std::cerr << "warning: " << message << std::endl; }
 
 std::string MessageNaming(const Status& status, const std::string& path) {
-  if (status.message().find(path) != std::string::npos) return status.message();
-  return status.WithContext(path).message();
+  return status.Naming(path).message();
 }
 
 std::string CheckOutputFile(const std::string& path) {
@@ -187,24 +186,6 @@ Result<PinholeCamera> ParseIntrinsics(const std::string& text) {
   return camera;
 }
 
-TimingSummary Summarize(std::vector<double> values_ms) {
-  TimingSummary s;
-  if (values_ms.empty()) return s;
-  std::sort(values_ms.begin(), values_ms.end());
-  // Linear interpolation between closest ranks.
-  auto quantile = [&](double q) {
-    const double pos = q * double(values_ms.size() - 1);
-    const size_t lo = size_t(std::floor(pos));
-    const size_t hi = std::min(lo + 1, values_ms.size() - 1);
-    return values_ms[lo] + (pos - double(lo)) * (values_ms[hi] - values_ms[lo]);
-  };
-  s.median = quantile(0.5);
-  s.p90 = quantile(0.9);
-  s.total = std::accumulate(values_ms.begin(), values_ms.end(), 0.0);
-  s.mean = s.total / double(values_ms.size());
-  return s;
-}
-
 Progress::Progress(std::string label, size_t total)
     : label_(std::move(label)), total_(total), tty_(::isatty(STDERR_FILENO) == 1) {}
 
@@ -252,11 +233,6 @@ double PeakRssMb() {
   rusage usage{};
   if (getrusage(RUSAGE_SELF, &usage) != 0) return 0.0;
   return RoundTo(double(usage.ru_maxrss) / 1024.0, 1);  // ru_maxrss is KiB on Linux
-}
-
-double RoundTo(double value, int decimals) {
-  const double scale = std::pow(10.0, decimals);
-  return std::round(value * scale) / scale;
 }
 
 double Mib(size_t bytes) { return RoundTo(double(bytes) / (1024.0 * 1024.0), 3); }

@@ -14,6 +14,7 @@
 #include "core/mesh.h"
 #include "core/status.h"
 #include "core/stopwatch.h"
+#include "core/summary.h"
 #include "core/volume.h"
 #include "io/dataset.h"
 #include "io/text_file.h"
@@ -99,11 +100,6 @@ int OpenDatasetInput(const DatasetInput& in, DatasetOptions options, OpenedDatas
 // "fx,fy,cx,cy" -> camera with width/height 0 (the dataset's images give the size).
 Result<PinholeCamera> ParseIntrinsics(const std::string& text);
 
-struct TimingSummary {
-  double median = 0.0, p90 = 0.0, mean = 0.0, total = 0.0;
-};
-TimingSummary Summarize(std::vector<double> values_ms);
-
 // Progress on stderr: a redrawn bar on a terminal, else a plain line every ~10% so logs
 // stay short.
 class Progress {
@@ -131,7 +127,6 @@ double PeakRssMb();  // MiB, from getrusage
 void AddMapStats(nlohmann::json& j, const TsdfVolume& volume);
 void AddMeshStats(nlohmann::json& j, const Mesh& mesh, double mesh_ms);
 
-double RoundTo(double value, int decimals);
 double Mib(size_t bytes);
 
 // Writes JSON (pretty) through WriteAtomically; the error names the file.

@@ -1,0 +1,16 @@
+#pragma once
+// Numbers as voxplan reports them: the median, 90th percentile, mean and total of a series
+// (timings, mostly), and rounding to a number of decimals for JSON outputs.
+#include <vector>
+
+namespace voxplan {
+
+struct TimingSummary {
+  double median = 0.0, p90 = 0.0, mean = 0.0, total = 0.0;
+};
+// Percentiles interpolate linearly between closest ranks; all 0 for an empty series.
+TimingSummary Summarize(std::vector<double> values);
+
+double RoundTo(double value, int decimals);
+
+}  // namespace voxplan
