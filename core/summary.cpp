@@ -1,5 +1,7 @@
 #include "core/summary.h"
 
+#include <sys/resource.h>
+
 #include <algorithm>
 #include <cmath>
 #include <cstddef>
@@ -27,6 +29,14 @@ TimingSummary Summarize(std::vector<double> values) {
 double RoundTo(double value, int decimals) {
   const double scale = std::pow(10.0, decimals);
   return std::round(value * scale) / scale;
+}
+
+double Mib(size_t bytes) { return RoundTo(double(bytes) / (1024.0 * 1024.0), 3); }
+
+double PeakRssMb() {
+  rusage usage{};
+  if (getrusage(RUSAGE_SELF, &usage) != 0) return 0.0;
+  return RoundTo(double(usage.ru_maxrss) / 1024.0, 1);  // ru_maxrss is KiB on Linux
 }
 
 }  // namespace voxplan

@@ -1,6 +1,7 @@
 #pragma once
 // Numbers as voxplan reports them: the median, 90th percentile, mean and total of a series
-// (timings, mostly), and rounding to a number of decimals for JSON outputs.
+// (timings, mostly), rounding to a number of decimals for JSON outputs, memory in MiB.
+#include <cstddef>
 #include <vector>
 
 namespace voxplan {
@@ -12,5 +13,8 @@ struct TimingSummary {
 TimingSummary Summarize(std::vector<double> values);
 
 double RoundTo(double value, int decimals);
+
+double Mib(size_t bytes);  // to 0.001 MiB
+double PeakRssMb();        // the process's peak resident memory, MiB to 0.1 (getrusage)
 
 }  // namespace voxplan

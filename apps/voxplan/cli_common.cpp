@@ -229,14 +229,6 @@ void Progress::Finish() {
   }
 }
 
-double PeakRssMb() {
-  rusage usage{};
-  if (getrusage(RUSAGE_SELF, &usage) != 0) return 0.0;
-  return RoundTo(double(usage.ru_maxrss) / 1024.0, 1);  // ru_maxrss is KiB on Linux
-}
-
-double Mib(size_t bytes) { return RoundTo(double(bytes) / (1024.0 * 1024.0), 3); }
-
 Status WriteJsonFile(const nlohmann::json& json, const std::string& path) {
   const std::string text = json.dump(2) + "\n";
   return WriteAtomically(

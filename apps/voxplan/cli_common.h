@@ -2,9 +2,9 @@
 // Helpers every voxplan subcommand shares: exit codes, error printing, output-path checks,
 // timing summaries, progress reporting and the one-line JSON result.
 #include <CLI/CLI.hpp>
-#include <chrono>
 #include <cstddef>
 #include <functional>
+#include <map>
 #include <memory>
 #include <nlohmann/json.hpp>
 #include <string>
@@ -16,6 +16,7 @@
 #include "core/stopwatch.h"
 #include "core/summary.h"
 #include "core/volume.h"
+#include "fusion/integrate.h"
 #include "io/dataset.h"
 #include "io/text_file.h"
 #include "sim/scene_loader.h"
@@ -97,6 +98,10 @@ struct OpenedDataset {
 // `options` carries any intrinsics or depth-scale override; its format is set from `in`.
 int OpenDatasetInput(const DatasetInput& in, DatasetOptions options, OpenedDataset* out);
 
+// --kernel of fuse and bench: the integration kernel by name.
+inline const std::map<std::string, Kernel> kIntegrationKernels = {
+    {"auto", Kernel::kAuto}, {"scalar", Kernel::kScalar}, {"simd", Kernel::kSimd}};
+
 // "fx,fy,cx,cy" -> camera with width/height 0 (the dataset's images give the size).
 Result<PinholeCamera> ParseIntrinsics(const std::string& text);
 
@@ -120,14 +125,10 @@ class Progress {
   int last_percent_ = -1;
 };
 
-double PeakRssMb();  // MiB, from getrusage
-
 // The map's size keys (blocks, voxels, bytes_per_voxel, map_mb) and the mesh keys
 // (mesh_vertices, mesh_triangles, mesh_ms) every command that builds them reports alike.
 void AddMapStats(nlohmann::json& j, const TsdfVolume& volume);
 void AddMeshStats(nlohmann::json& j, const Mesh& mesh, double mesh_ms);
-
-double Mib(size_t bytes);
 
 // Writes JSON (pretty) through WriteAtomically; the error names the file.
 Status WriteJsonFile(const nlohmann::json& json, const std::string& path);

@@ -23,9 +23,6 @@ namespace {
 using bench::BenchMode;
 using nlohmann::json;
 
-const std::map<std::string, Kernel> kKernels = {
-    {"auto", Kernel::kAuto}, {"scalar", Kernel::kScalar}, {"simd", Kernel::kSimd}};
-
 constexpr int kMaxThreadCount = 4096;
 
 Result<std::vector<int>> ParseThreadList(const std::string& text) {
@@ -81,7 +78,7 @@ int RunBench(const BenchOptions& o, BenchMode mode) {
   IntegrateParams params;
   params.min_depth_m = float(o.in.min_depth_m);
   params.max_depth_m = float(o.in.max_depth_m);
-  params.kernel = kKernels.at(o.kernel);
+  params.kernel = kIntegrationKernels.at(o.kernel);
   bench::FusionBenchParams fp;
   fp.mode = mode;
   fp.volume = {float(o.voxel_size_m), float(o.trunc_m)};

@@ -45,7 +45,7 @@ int RunBenchMaps(const MapsOptions& o) {
                           [](const std::string& text) { std::cerr << text << std::flush; });
   if (!result.ok()) return Fail(result.status().message());
   const TsdfVolume& volume = *result->volume;
-  const bench::TimingSummary& maps = result->maps_ms;
+  const TimingSummary& maps = result->maps_ms;
 
   json j;
   j["command"] = "bench maps";

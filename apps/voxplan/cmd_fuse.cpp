@@ -27,8 +27,6 @@ namespace fs = std::filesystem;
 
 const std::map<std::string, Weighting> kWeightings = {{"constant", Weighting::kConstant},
                                                       {"depth", Weighting::kDepthDependent}};
-const std::map<std::string, Kernel> kKernels = {
-    {"auto", Kernel::kAuto}, {"scalar", Kernel::kScalar}, {"simd", Kernel::kSimd}};
 
 struct FuseOptions {
   DatasetInput in;
@@ -173,7 +171,7 @@ int RunFuse(const FuseOptions& o) {
   params.max_depth_m = float(o.in.max_depth_m);
   params.max_weight = float(o.max_weight);
   params.weighting = kWeightings.at(o.weighting);
-  params.kernel = kKernels.at(o.kernel);
+  params.kernel = kIntegrationKernels.at(o.kernel);
   TsdfVolume volume(VolumeParams{float(o.voxel_size_m), float(o.trunc_m)});
 
   std::cerr << "fuse: " << info.root << " (" << DatasetFormatName(info.format) << "), "

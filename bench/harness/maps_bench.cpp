@@ -23,12 +23,6 @@ struct LoadedFrame {
   Pose3f T_W_C;
 };
 
-// The library's message, with `path` in front unless it already names it.
-Status Naming(const Status& status, const std::string& path) {
-  if (status.message().find(path) != std::string::npos) return status;
-  return status.WithContext(path);
-}
-
 // The valid pixels of a frame as world points: what OctoMap's insertPointCloud takes.
 octomap::Pointcloud WorldCloud(const LoadedFrame& f, const PinholeCamera& cam, float min_depth_m,
                                float max_depth_m) {
@@ -107,7 +101,7 @@ Result<MapsBenchResult> RunMapsBench(const Dataset& dataset, const std::vector<s
   size_t skipped = 0;
   for (size_t i : indices) {
     Result<Frame> frame = dataset.Load(i);
-    if (!frame.ok()) return Naming(frame.status(), p.dataset_name);
+    if (!frame.ok()) return frame.status().Naming(p.dataset_name);
     const bool has_depth = std::any_of(frame->depth.data.begin(), frame->depth.data.end(),
                                        [](float z) { return z > 0.f; });
     if (!frame->T_W_C || !has_depth) {

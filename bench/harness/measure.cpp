@@ -1,50 +1,17 @@
-// Timing summaries, memory figures and the machine description for the bench harness.
+// Table cells and the machine description for the bench harness.
 #include "bench/harness/measure.h"
 
 #include <sched.h>
-#include <sys/resource.h>
 
 #include <algorithm>
 #include <cmath>
 #include <fstream>
 #include <iomanip>
-#include <numeric>
 #include <sstream>
 
 #include "core/parallel.h"
 
 namespace voxplan::bench {
-
-TimingSummary Summarize(std::vector<double> values_ms) {
-  TimingSummary s;
-  if (values_ms.empty()) return s;
-  std::sort(values_ms.begin(), values_ms.end());
-  // Linear interpolation between closest ranks.
-  auto quantile = [&](double q) {
-    const double pos = q * double(values_ms.size() - 1);
-    const size_t lo = size_t(std::floor(pos));
-    const size_t hi = std::min(lo + 1, values_ms.size() - 1);
-    return values_ms[lo] + (pos - double(lo)) * (values_ms[hi] - values_ms[lo]);
-  };
-  s.median = quantile(0.5);
-  s.p90 = quantile(0.9);
-  s.total = std::accumulate(values_ms.begin(), values_ms.end(), 0.0);
-  s.mean = s.total / double(values_ms.size());
-  return s;
-}
-
-double PeakRssMb() {
-  rusage usage{};
-  if (getrusage(RUSAGE_SELF, &usage) != 0) return 0.0;
-  return RoundTo(double(usage.ru_maxrss) / 1024.0, 1);  // ru_maxrss is KiB on Linux
-}
-
-double RoundTo(double value, int decimals) {
-  const double scale = std::pow(10.0, decimals);
-  return std::round(value * scale) / scale;
-}
-
-double Mib(size_t bytes) { return RoundTo(double(bytes) / (1024.0 * 1024.0), 3); }
 
 std::string Cell(const std::optional<double>& v, int decimals) {
   if (!v) return "-";

@@ -1,23 +1,15 @@
 #pragma once
-// What the bench runs share: timing summaries, memory figures, the machine, the progress
-// callback. The same arithmetic as the CLI's helpers (apps/ sits above the libraries).
+// What the bench runs share beside core/summary.h: table cells, the machine, the progress
+// callback.
 #include <cstddef>
 #include <functional>
 #include <optional>
 #include <string>
 #include <vector>
 
+#include "core/summary.h"
+
 namespace voxplan::bench {
-
-struct TimingSummary {
-  double median = 0.0, p90 = 0.0, mean = 0.0, total = 0.0;
-};
-// Quantiles by linear interpolation between closest ranks; all zero when empty.
-TimingSummary Summarize(std::vector<double> values_ms);
-
-double PeakRssMb();  // MiB to 0.1, from getrusage
-double RoundTo(double value, int decimals);
-double Mib(size_t bytes);  // to 0.001
 
 // A figure in a progress line or table cell: fixed with `decimals` decimals, "-" when absent.
 std::string Cell(const std::optional<double>& v, int decimals = 2);

@@ -116,8 +116,8 @@ struct ItemSize {
 
 // One extent of an item: fixed, or drawn uniform in [lo, hi) (as a double, then rounded).
 struct Extent {
-  constexpr Extent(float fixed_m = 0) : fixed_m(fixed_m) {}
-  constexpr Extent(double lo_m, double hi_m) : drawn(true), lo_m(lo_m), hi_m(hi_m) {}
+  constexpr Extent(float fixed = 0) : fixed_m(fixed) {}
+  constexpr Extent(double lo, double hi) : drawn(true), lo_m(lo), hi_m(hi) {}
   float Draw(Rng& rng) const { return drawn ? float(rng.Uniform(lo_m, hi_m)) : fixed_m; }
 
   bool drawn = false;

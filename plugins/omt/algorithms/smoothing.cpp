@@ -27,8 +27,9 @@ T Eta(const Field& field, const RasterGeometry& g, const T& x, const T& y) {
 }
 
 struct SegmentTerm {
-  SegmentTerm(const Field* field, const RasterGeometry* g, double floor, double cap)
-      : field(field), g(g), floor(floor), cap(cap) {}
+  SegmentTerm(const Field* eta_field, const RasterGeometry* geometry, double eta_floor,
+              double eta_cap)
+      : field(eta_field), g(geometry), floor(eta_floor), cap(eta_cap) {}
   template <typename T>
   bool operator()(const T* a, const T* b, T* residual) const {
     const T ea = std::clamp(Eta(*field, *g, a[0], a[1]), T(floor), T(cap));
@@ -45,7 +46,7 @@ struct SegmentTerm {
 };
 
 struct AnchorTerm {
-  AnchorTerm(Eigen::Vector2d p0, double sqrt_lambda) : p0(std::move(p0)), s(sqrt_lambda) {}
+  AnchorTerm(Eigen::Vector2d anchor, double sqrt_lambda) : p0(std::move(anchor)), s(sqrt_lambda) {}
   template <typename T>
   bool operator()(const T* p, T* residual) const {
     residual[0] = T(s) * (p[0] - T(p0.x()));
@@ -57,8 +58,9 @@ struct AnchorTerm {
 };
 
 struct ClearanceTerm {
-  ClearanceTerm(const Field* field, const RasterGeometry* g, double min_c, double weight)
-      : field(field), g(g), min_c(min_c), weight(weight) {}
+  ClearanceTerm(const Field* clearance, const RasterGeometry* geometry, double min_clearance,
+                double term_weight)
+      : field(clearance), g(geometry), min_c(min_clearance), weight(term_weight) {}
   template <typename T>
   bool operator()(const T* p, T* residual) const {
     const T eta = Eta(*field, *g, p[0], p[1]);
