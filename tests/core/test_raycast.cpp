@@ -15,7 +15,7 @@
 
 #include "core/parallel.h"
 #include "core/raycast.h"
-#include "core/raycast_kernels.h"
+#include "core/raycast/raycast_kernels.h"
 #include "tests/support/test_support.h"
 
 namespace voxplan {
@@ -533,7 +533,7 @@ TEST(Raycast, InvalidInputsGiveEmptyOrUnobservedImages) {
   EXPECT_EQ(Count(images, RayStatus::kUnobserved), images.status.data.size());
 }
 
-// The caster's SSE2 kernels against their scalar references (core/raycast_kernels.h).
+// The caster's SSE2 kernels against their scalar references (core/raycast/raycast_kernels.h).
 namespace kernels = raycast_detail;
 
 TsdfBlock RandomBlock(std::mt19937& rng) {

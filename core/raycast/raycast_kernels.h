@@ -1,5 +1,5 @@
 #pragma once
-// Inner kernels of the TSDF ray caster (core/raycast.cpp), each as a portable scalar reference
+// Inner kernels of the TSDF ray caster (core/raycast/), each as a portable scalar reference
 // and an SSE2 version (x86-64's baseline, so no runtime CPU check is needed). Kept in a header
 // so that the caster inlines them and the tests can check the two against each other.
 // A cell position `frac` is four floats: x, y, z in [0, 1] and one that is read but unused.
