@@ -156,7 +156,7 @@ inline float ValueAndGradientSse2(const float t[8], const float frac[4], float g
   const __m128 fy = _mm_shuffle_ps(f, f, _MM_SHUFFLE(1, 1, 1, 1));
   const __m128 fz = _mm_shuffle_ps(f, f, _MM_SHUFFLE(2, 2, 2, 2));
   // Lane weights (1 - f or f) as a + b f, with a and b constant per lane.
-  auto lerp_weights = [](__m128 a, __m128 b, __m128 f) { return _mm_add_ps(a, _mm_mul_ps(b, f)); };
+  auto lerp_weights = [](__m128 a, __m128 b, __m128 x) { return _mm_add_ps(a, _mm_mul_ps(b, x)); };
   const __m128 one_zero = _mm_set_ps(0.f, 1.f, 0.f, 1.f),
                sign_alt = _mm_set_ps(1.f, -1.f, 1.f, -1.f);
   const __m128 one_one = _mm_set_ps(0.f, 0.f, 1.f, 1.f),

@@ -158,8 +158,8 @@ class Sampler {
     const TsdfBlock* neighbour[8];
     // The neighbours bypass the last-block shortcut, which keeps b0 for the next gather.
     auto find = [&](int dx, int dy, int dz) {
-      const TsdfBlock* block = cache_.Find(BlockIndex{b0.x + dx, b0.y + dy, b0.z + dz});
-      return block ? block : &kNoBlock;
+      const TsdfBlock* found = cache_.Find(BlockIndex{b0.x + dx, b0.y + dy, b0.z + dz});
+      return found ? found : &kNoBlock;
     };
     const TsdfBlock* block0 = Find(b0);
     neighbour[0] = block0 ? block0 : &kNoBlock;
