@@ -14,10 +14,8 @@
 #include "fusion/mesh_extract.h"
 #include "io/dataset.h"
 #include "io/frame_list.h"
-#include "io/map_io.h"
-#include "io/mesh_io.h"
-#include "io/tum_trajectory.h"
 #include "pipeline/fuse_dataset.h"
+#include "pipeline/fuse_outputs.h"
 
 namespace voxplan::cli {
 
@@ -46,48 +44,6 @@ struct FuseOptions {
 
 nlohmann::json OrNull(const std::string& path) {
   return path.empty() ? nlohmann::json(nullptr) : nlohmann::json(path);
-}
-
-// The mesh (extracted here), map, trajectory and frame list that were asked for.
-Status WriteFuseOutputs(const FuseOptions& o, const DatasetInfo& info, const TsdfVolume& volume,
-                        const FuseReport& report, Mesh* mesh, double* mesh_ms) {
-  if (!o.mesh_path.empty()) {
-    const Stopwatch mesh_clock;
-    MeshParams mesh_params;
-    mesh_params.min_weight = float(o.mesh_min_weight);
-    *mesh = ExtractMesh(volume, mesh_params);
-    *mesh_ms = mesh_clock.ElapsedMs();
-    if (Status s = WriteMesh(*mesh, o.mesh_path); !s.ok()) {
-      return Status(s.code(), MessageNaming(s, o.mesh_path));
-    }
-  }
-  if (!o.map_path.empty()) {
-    if (Status s = SaveMap(volume, o.map_path); !s.ok())
-      return Status(s.code(), MessageNaming(s, o.map_path));
-  }
-  if (!o.trajectory_path.empty()) {
-    std::vector<double> timestamps_s;
-    std::vector<Pose3f> poses;
-    for (const FusedFrame& f : report.frames) {
-      timestamps_s.push_back(f.timestamp_s);
-      poses.push_back(f.T_W_C);
-    }
-    if (Status s = WriteTumTrajectory(o.trajectory_path, timestamps_s, poses); !s.ok())
-      return Status(s.code(), MessageNaming(s, o.trajectory_path));
-  }
-  if (!o.frame_list_path.empty()) {
-    // Exactly the frames integrated, with the parameters, for reference runs of other
-    // pipelines (bench/open3d_fusion.py) on identical input.
-    std::vector<FrameListEntry> entries;
-    for (const FusedFrame& f : report.frames)
-      entries.push_back({f.depth_path, f.color_path, f.T_W_C.matrix().cast<double>()});
-    const FrameListParams list{info.camera, info.depth_scale, o.voxel_size_m,
-                               o.trunc_m,   o.in.min_depth_m, o.in.max_depth_m};
-    if (Status s = WriteFrameList(o.frame_list_path, list, entries); !s.ok())
-      return Status(s.code(), MessageNaming(s, o.frame_list_path));
-  }
-
-  return Status::Ok();
 }
 
 // The stats object: the same on the last stdout line and in --stats.
@@ -198,11 +154,16 @@ int RunFuse(const FuseOptions& o) {
                 " selected, all skipped): " + o.in.dataset);
   }
 
-  Mesh mesh;
-  double mesh_ms = 0.0;
-  if (Status s = WriteFuseOutputs(o, info, volume, report, &mesh, &mesh_ms); !s.ok())
-    return Fail(s.message());
-  const nlohmann::json j = FuseStats(o, info, params, report, volume, mesh, mesh_ms);
+  MeshParams mesh_params;
+  mesh_params.min_weight = float(o.mesh_min_weight);
+  const FrameListParams list{info.camera, info.depth_scale, o.voxel_size_m,
+                             o.trunc_m,   o.in.min_depth_m, o.in.max_depth_m};
+  Result<FuseOutputs> outputs =
+      WriteFuseOutputs({o.mesh_path, o.map_path, o.trajectory_path, o.frame_list_path}, volume,
+                       report, mesh_params, list);
+  if (!outputs.ok()) return Fail(outputs.status().message());
+  const Mesh& mesh = outputs->mesh;
+  const nlohmann::json j = FuseStats(o, info, params, report, volume, mesh, outputs->mesh_ms);
   const size_t integrated = report.frames.size();
   if (!o.stats_path.empty()) {
     if (Status s = WriteJsonFile(j, o.stats_path); !s.ok()) {

@@ -1,0 +1,30 @@
+#pragma once
+// The files a fusion run writes beside its stats: the mesh (extracted here), the map, the
+// trajectory of the poses used and the frame list for reference pipelines. Each is written
+// through a temporary file and renamed; an empty path skips it.
+#include <string>
+
+#include "core/mesh.h"
+#include "core/status.h"
+#include "core/volume.h"
+#include "fusion/mesh_extract.h"
+#include "io/frame_list.h"
+#include "pipeline/fuse_dataset.h"
+
+namespace voxplan {
+
+struct FuseOutputPaths {
+  std::string mesh, map, trajectory, frame_list;
+};
+
+struct FuseOutputs {
+  Mesh mesh;             // empty unless a mesh was asked for
+  double mesh_ms = 0.0;  // its extraction time
+};
+
+// `list` carries the camera and parameters the frame list records. A failure names the file.
+Result<FuseOutputs> WriteFuseOutputs(const FuseOutputPaths& paths, const TsdfVolume& volume,
+                                     const FuseReport& report, const MeshParams& mesh_params,
+                                     const FrameListParams& list);
+
+}  // namespace voxplan
