@@ -35,6 +35,26 @@ SceneLoadOptions SceneLoad(const SceneFrameOptions& frame) {
   return load;
 }
 
+void AddSceneOptions(CLI::App* sub, SceneOptions* s, bool required) {
+  CLI::Option* scene = sub->add_option(
+      "--scene", s->scene, "Ground-truth world mesh; its instance table is <stem>_instances.tsv");
+  if (required) scene->required();
+  sub->add_option("--instances", s->instances, "Instance table of the world (default: beside it)");
+  AddSceneFrameOptions(sub, s->frame);
+}
+
+Result<World> LoadScene(const SceneOptions& s) {
+  std::error_code ec;
+  if (!fs::is_regular_file(s.scene, ec)) return NotFound("scene file not found: " + s.scene);
+  if (!s.instances.empty() && !fs::is_regular_file(s.instances, ec))
+    return NotFound("instance table not found: " + s.instances);
+  SceneLoadOptions load = SceneLoad(s.frame);
+  load.instance_table = s.instances;
+  Result<World> world = LoadWorld(s.scene, load);
+  if (!world.ok()) return world.status().WithContext(s.scene);
+  return world;
+}
+
 void AddDatasetInputOptions(CLI::App* sub, DatasetInput& in, bool with_start) {
   sub->add_option("dataset", in.dataset, "Dataset folder")->required();
   sub->add_option("--format", in.format, "Dataset format")

@@ -43,12 +43,14 @@ Command AddBenchCommand(CLI::App& app);
 Command AddSimCommand(CLI::App& app);
 Command AddExploreCommand(CLI::App& app);  // explore (cmd_explore.cpp)
 // Subcommands that live in their own files, added to a parent command above.
-Command AddSimSceneCommand(CLI::App& sim);     // sim scene   (cmd_sim_scene.cpp)
-Command AddSimRenderCommand(CLI::App& sim);    // sim render  (cmd_sim_render.cpp)
-Command AddSimTourCommand(CLI::App& sim);      // sim tour    (cmd_sim_tour.cpp)
-Command AddBenchMapsCommand(CLI::App& bench);  // bench maps  (cmd_bench_maps.cpp)
-std::vector<Command> AddEvalSimCommands(
-    CLI::App& eval);  // eval of simulated runs (cmd_eval_sim.cpp)
+Command AddSimSceneCommand(CLI::App& sim);         // sim scene       (cmd_sim_scene.cpp)
+Command AddSimRenderCommand(CLI::App& sim);        // sim render      (cmd_sim_render.cpp)
+Command AddSimTourCommand(CLI::App& sim);          // sim tour        (cmd_sim_tour.cpp)
+Command AddBenchMapsCommand(CLI::App& bench);      // bench maps      (cmd_bench_maps.cpp)
+Command AddEvalMeshCommand(CLI::App& eval);        // eval mesh       (cmd_eval_mesh.cpp)
+Command AddEvalTrajectoryCommand(CLI::App& eval);  // eval trajectory (cmd_eval_trajectory.cpp)
+Command AddEvalObjectsCommand(CLI::App& eval);     // eval objects    (cmd_eval_objects.cpp)
+Command AddEvalRunCommand(CLI::App& eval);         // eval run        (cmd_eval_run.cpp)
 // Runs the parsed one of `commands`; fails with a usage error when none was.
 int RunParsed(const std::vector<Command>& commands);
 
@@ -75,6 +77,17 @@ struct SceneFrameOptions {
 void AddSceneFrameOptions(CLI::App* sub, SceneFrameOptions& frame);
 // The load options they ask for (the rest at their defaults).
 SceneLoadOptions SceneLoad(const SceneFrameOptions& frame);
+
+// The world of --scene: the mesh and its instance table (`<stem>_instances.tsv` beside it unless
+// given), as `voxplan sim scene` writes them; eval objects and eval run read it.
+struct SceneOptions {
+  std::string scene;
+  std::string instances;
+  SceneFrameOptions frame;
+};
+void AddSceneOptions(CLI::App* sub, SceneOptions* s, bool required);
+// Refuses a missing scene file or instance table, then loads the world; errors name the scene.
+Result<World> LoadScene(const SceneOptions& s);
 
 // The dataset a command reads and which of its frames: the positional folder, --format,
 // --min-depth, --max-depth, --frames, --stride (and --start where asked for).

@@ -1,0 +1,47 @@
+// RenderViews: poses (given or an orbit), one depth range per turntable, render, count hits,
+// shade.
+#include "viewer_offscreen/render_views.h"
+
+#include <algorithm>
+#include <cmath>
+#include <utility>
+
+#include "core/camera.h"
+
+namespace voxplan {
+
+Result<RenderedViews> RenderViews(const SurfaceScene& scene, const RenderViewsParams& params) {
+  RenderedViews views;
+  const PinholeCamera camera = CameraFromFov(params.width, params.height, params.fov_deg);
+  views.bounds_W = scene.Bounds();
+  OrbitFraming& framing = views.framing;
+  framing = FrameBox(views.bounds_W, camera, params.orbit_elevation_deg);
+  if (params.orbit_radius_m) framing.radius_m = *params.orbit_radius_m;
+  if (params.orbit_height_m) framing.height_m = *params.orbit_height_m;
+  framing.distance_m = std::hypot(framing.radius_m, framing.height_m);
+  ShadeParams shade;
+  if (params.T_W_C) {
+    views.T_W_C.push_back(*params.T_W_C);  // depth range: per image
+  } else {
+    views.T_W_C = OrbitPoses(framing.centre_W, framing.radius_m, framing.height_m,
+                             std::max(params.orbit_views, 1), params.up_W);
+    // One depth range for the whole turntable, so colours mean the same depth in every view.
+    shade.depth_near_m = std::max(0.0f, framing.distance_m - framing.bound_radius_m);
+    shade.depth_far_m = framing.distance_m + framing.bound_radius_m;
+  }
+
+  double hit_fraction_sum = 0.0;
+  for (const Pose3f& T_W_C : views.T_W_C) {
+    const SurfaceImages surface = scene.Render(camera, T_W_C);
+    const size_t hits = size_t(std::count_if(surface.depth.data.begin(), surface.depth.data.end(),
+                                             [](float z) { return z > 0.0f; }));
+    hit_fraction_sum += double(hits) / double(surface.depth.data.size());
+    Result<ColorImage> image = Shade(surface, camera, T_W_C, params.mode, shade);
+    if (!image.ok()) return image.status();
+    views.images.push_back(std::move(*image));
+  }
+  views.hit_fraction = hit_fraction_sum / double(views.T_W_C.size());
+  return views;
+}
+
+}  // namespace voxplan

@@ -1,0 +1,42 @@
+#pragma once
+// Shaded views of a SurfaceScene: one from a given pose or a turntable framed on its bounds,
+// all kept in memory so a caller writes files only once every view has rendered.
+#include <Eigen/Geometry>
+#include <optional>
+#include <vector>
+
+#include "core/image.h"
+#include "core/pose.h"
+#include "core/status.h"
+#include "viewer_offscreen/orbit.h"
+#include "viewer_offscreen/shading.h"
+#include "viewer_offscreen/surface_scene.h"
+
+namespace voxplan {
+
+struct RenderViewsParams {
+  int width = 640;
+  int height = 480;
+  float fov_deg = 60.0f;  // horizontal
+  ShadeMode mode = ShadeMode::kShaded;
+  // One view from here (its depth colour range from the image); unset: an orbit.
+  std::optional<Pose3f> T_W_C;
+  int orbit_views = 1;  // at least one
+  Eigen::Vector3f up_W = Eigen::Vector3f::UnitZ();
+  std::optional<float> orbit_radius_m;  // across the up axis; unset: framed on the bounds
+  std::optional<float> orbit_height_m;  // along the up axis; unset: framed on the bounds
+  float orbit_elevation_deg = 35.0f;    // of the framing
+};
+
+struct RenderedViews {
+  Eigen::AlignedBox3f bounds_W;
+  OrbitFraming framing;       // the orbit (its centre is reported with a pose too)
+  std::vector<Pose3f> T_W_C;  // one per image
+  std::vector<ColorImage> images;
+  double hit_fraction = 0.0;  // mean over the views of the share of pixels on a surface
+};
+
+// Renders and shades every view; fails only when shading refuses an image.
+Result<RenderedViews> RenderViews(const SurfaceScene& scene, const RenderViewsParams& params);
+
+}  // namespace voxplan

@@ -1,0 +1,20 @@
+#pragma once
+// What `voxplan render` draws: anything that ray casts to SurfaceImages (a TSDF map here, an
+// Embree mesh in sim/mesh_scene.h), so framing, shading and file writing are written once.
+#include <Eigen/Geometry>
+
+#include "core/camera.h"
+#include "core/pose.h"
+#include "viewer_offscreen/shading.h"
+
+namespace voxplan {
+
+class SurfaceScene {
+ public:
+  virtual ~SurfaceScene() = default;
+  // World box around everything the scene can show, for orbit framing.
+  virtual Eigen::AlignedBox3f Bounds() const = 0;
+  virtual SurfaceImages Render(const PinholeCamera& camera, const Pose3f& T_W_C) const = 0;
+};
+
+}  // namespace voxplan
