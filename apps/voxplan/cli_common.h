@@ -10,6 +10,7 @@
 #include <string>
 #include <vector>
 
+#include "apps/voxplan/progress.h"
 #include "core/camera.h"
 #include "core/mesh.h"
 #include "core/status.h"
@@ -117,26 +118,6 @@ inline const std::map<std::string, Kernel> kIntegrationKernels = {
 
 // "fx,fy,cx,cy" -> camera with width/height 0 (the dataset's images give the size).
 Result<PinholeCamera> ParseIntrinsics(const std::string& text);
-
-// Progress on stderr: a redrawn bar on a terminal, else a plain line every ~10% so logs
-// stay short.
-class Progress {
- public:
-  Progress(std::string label, size_t total);
-  void Update(size_t done);
-  // Prints a warning without tearing the bar.
-  void Warn(const std::string& message);
-  void Finish();
-
- private:
-  void ClearBar();
-  std::string label_;
-  size_t total_;
-  bool tty_;
-  bool bar_drawn_ = false;
-  int last_decile_ = -1;
-  int last_percent_ = -1;
-};
 
 // The map's size keys (blocks, voxels, bytes_per_voxel, map_mb) and the mesh keys
 // (mesh_vertices, mesh_triangles, mesh_ms) every command that builds them reports alike.
