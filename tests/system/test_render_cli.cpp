@@ -124,6 +124,32 @@ TEST(RenderCliTest, MapFromAPoseSeesThePlane) {
   EXPECT_TRUE(fs::exists(dir / "orbit" / "render_000.png"));
 }
 
+// --kernel scalar marches the scalar reference: the same pixels as the default (AVX2) march.
+TEST(RenderCliTest, ScalarKernelRendersTheSameImages) {
+  const test::TempDir dir("voxplan-render");
+  const fs::path map = dir / "plane.vpmap";
+  WritePlaneMap(map);
+  std::vector<ColorImage> images;
+  for (const char* kernel : {"auto", "scalar"}) {
+    const fs::path out = dir / kernel;
+    const RunResult r = RunCli({"render", map.string(), "--orbit", "2", "--size", "80x60", "--mode",
+                                "normals", "--kernel", kernel, "--out", out.string()});
+    ASSERT_EQ(r.exit_code, 0) << Describe(r);
+    EXPECT_GT(r.last_json.at("hit_fraction").get<double>(), 0.1) << Describe(r);
+    for (const char* name : {"render_000.png", "render_001.png"}) {
+      Result<ColorImage> image = ReadColorImage((out / name).string());
+      ASSERT_TRUE(image.ok()) << image.status().message();
+      images.push_back(std::move(*image));
+    }
+  }
+  ASSERT_EQ(images.size(), 4u);
+  EXPECT_EQ(images[0].data, images[2].data);
+  EXPECT_EQ(images[1].data, images[3].data);
+  const RunResult bad =
+      RunCli({"render", map.string(), "--kernel", "simd", "--out", (dir / "bad").string()});
+  EXPECT_EQ(bad.exit_code, 2) << Describe(bad);
+}
+
 TEST(RenderCliTest, RefusesBadArgumentsAndWritesNothing) {
   const test::TempDir dir("voxplan-render");
   const fs::path mesh = dir / "cube.ply", out = dir / "never";
