@@ -190,8 +190,7 @@ Status WriteRunLog(const std::vector<RobotTrack>& tracks, const std::string& pat
             FormatDouble(s.cam_yaw_rad) + ',' + FormatDouble(s.cam_pitch_rad) + ',' +
             (s.status == RobotStatus::kBusy ? "busy" : "idle") + ',' + s.mode + '\n';
   }
-  return WriteAtomically(path,
-                         [&](const std::string& tmp) { return WriteStringToFile(tmp, text); });
+  return WriteFileAtomically(path, text);
 }
 
 Result<RunMetrics> EvaluateRun(const std::vector<RobotTrack>& tracks, const RunEvalParams& params) {
@@ -324,8 +323,7 @@ Status WriteRunTimeSeriesCsv(const std::vector<RunTimePoint>& series, const std:
     text += field(p.t_s) + ',' + field(p.distance_total_m) + ',' + std::to_string(p.busy_robots) +
             ',' + field(p.coverage) + ',' + field(p.completeness) + '\n';
   }
-  return WriteAtomically(path,
-                         [&](const std::string& tmp) { return WriteStringToFile(tmp, text); });
+  return WriteFileAtomically(path, text);
 }
 
 }  // namespace voxplan

@@ -33,15 +33,10 @@ std::string InFolder(const std::string& out_dir, const char* name) {
   return (fs::path(out_dir) / name).string();
 }
 
-Status WriteText(const std::string& text, const std::string& path) {
-  return WriteAtomically(path,
-                         [&](const std::string& tmp) { return WriteStringToFile(tmp, text); });
-}
-
 Status WriteLines(const std::vector<std::string>& lines, const std::string& path) {
   std::string text;
   for (const std::string& l : lines) text += l + "\n";
-  return WriteText(text, path);
+  return WriteFileAtomically(path, text);
 }
 
 json MetricsObject(const ExploreRunParams& params, const ExploreRunReport& report) {
@@ -175,7 +170,7 @@ std::string RunSummaryJson(const ExploreRunParams& params, const ExploreRunRepor
 Status WriteRunOutputs(const ExploreRunParams& params, const ExploreRunReport& report) {
   const ExploreResult& r = report.loop;
   std::string path = InFolder(params.out_dir, "metrics.json");
-  VOXPLAN_RETURN_IF_ERROR(WriteText(MetricsObject(params, report).dump(2) + "\n", path));
+  VOXPLAN_RETURN_IF_ERROR(WriteFileAtomically(path, MetricsObject(params, report).dump(2) + "\n"));
 
   path = InFolder(params.out_dir, "run_log.csv");
   if (Status s = WriteRunLog(r.tracks, path); !s.ok()) return s.Naming(path);

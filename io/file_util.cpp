@@ -82,4 +82,9 @@ Result<std::string> ReadFileToString(const std::string& path) {
   return data;
 }
 
+Status WriteFileAtomically(const std::string& path, std::string_view data) {
+  return WriteAtomically(
+      path, [&](const std::string& tmp_path) { return WriteStringToFile(tmp_path, data); });
+}
+
 }  // namespace voxplan

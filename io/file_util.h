@@ -16,6 +16,9 @@ Status WriteAtomically(const std::string& path,
 // Writes `data` to `path` in one go (not atomic: use inside WriteAtomically's callback).
 Status WriteStringToFile(const std::string& path, std::string_view data);
 
+// WriteAtomically of WriteStringToFile: `data` replaces `path` whole or not at all.
+Status WriteFileAtomically(const std::string& path, std::string_view data);
+
 // Reads a whole file; the error names the file.
 Result<std::string> ReadFileToString(const std::string& path);
 

@@ -35,8 +35,7 @@ std::string FrameListJson(const FrameListParams& params, const std::vector<Frame
 Status WriteFrameList(const std::string& path, const FrameListParams& params,
                       const std::vector<FrameListEntry>& frames) {
   const std::string text = FrameListJson(params, frames, 2);
-  return WriteAtomically(
-      path, [&](const std::string& tmp_path) { return WriteStringToFile(tmp_path, text); });
+  return WriteFileAtomically(path, text);
 }
 
 }  // namespace voxplan

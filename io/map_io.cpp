@@ -164,6 +164,10 @@ Status WriteMapFile(const TsdfVolume& volume, const std::vector<BlockIndex>& blo
 
 }  // namespace
 
+bool IsMapPath(const std::string& path) {
+  return std::filesystem::path(path).extension() == ".vpmap";
+}
+
 Status SaveMap(const TsdfVolume& volume, const std::string& path) {
   const std::vector<BlockIndex> blocks = volume.SortedBlockIndices();
   return WriteAtomically(path,

@@ -12,6 +12,9 @@ namespace voxplan {
 
 inline constexpr uint32_t kMapFormatVersion = 1;
 
+// Whether `path` names a map file: the .vpmap extension.
+bool IsMapPath(const std::string& path);
+
 Status SaveMap(const TsdfVolume& volume, const std::string& path);
 Result<TsdfVolume> LoadMap(const std::string& path);
 

@@ -169,8 +169,7 @@ Status WriteMesh(const Mesh& mesh, const std::string& path) {
                     "cannot write mesh " + path + ": assimp produced more than one file");
     bytes.assign(static_cast<const char*>(blob->data), blob->size);
   }
-  return WriteAtomically(path,
-                         [&](const std::string& tmp) { return WriteStringToFile(tmp, bytes); });
+  return WriteFileAtomically(path, bytes);
 }
 
 bool IsSupportedMeshExtension(const std::string& path) {

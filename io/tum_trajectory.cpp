@@ -52,8 +52,7 @@ Status WriteTumTrajectory(const std::string& path, const std::vector<double>& ti
                   t.x(), t.y(), t.z(), q.x(), q.y(), q.z(), q.w());
     text += line;
   }
-  return WriteAtomically(
-      path, [&](const std::string& tmp_path) { return WriteStringToFile(tmp_path, text); });
+  return WriteFileAtomically(path, text);
 }
 
 Status WriteTumTrajectory(const std::string& path, const std::vector<double>& timestamps_s,

@@ -38,11 +38,6 @@ Status WriteLabelPng16(const std::string& path, const LabelImage& labels) {
   return WritePngRaw(path, labels.width, labels.height, 1, 16, samples.data());
 }
 
-Status WriteText(const std::string& path, const std::string& text) {
-  return WriteAtomically(path,
-                         [&](const std::string& tmp) { return WriteStringToFile(tmp, text); });
-}
-
 }  // namespace
 
 Status SimDatasetOptions::Validate() const {
@@ -149,17 +144,17 @@ Result<SimDatasetSummary> RenderSimDataset(const MeshRaycaster& raycaster,
                 options.camera.fy, options.camera.cx, options.camera.cy);
   const std::string camera_path = (root / "camera.txt").string();
   const std::string depth_path = (root / "depth.txt").string();
-  VOXPLAN_RETURN_IF_ERROR(WriteText(camera_path, camera));
-  VOXPLAN_RETURN_IF_ERROR(WriteText(depth_path, depth_txt));
+  VOXPLAN_RETURN_IF_ERROR(WriteFileAtomically(camera_path, camera));
+  VOXPLAN_RETURN_IF_ERROR(WriteFileAtomically(depth_path, depth_txt));
   summary.paths = {depth_path};
   if (options.write_color) {
     const std::string p = (root / "rgb.txt").string();
-    VOXPLAN_RETURN_IF_ERROR(WriteText(p, rgb_txt));
+    VOXPLAN_RETURN_IF_ERROR(WriteFileAtomically(p, rgb_txt));
     summary.paths.push_back(p);
   }
   if (options.write_labels) {
     const std::string p = (root / "labels.txt").string();
-    VOXPLAN_RETURN_IF_ERROR(WriteText(p, labels_txt));
+    VOXPLAN_RETURN_IF_ERROR(WriteFileAtomically(p, labels_txt));
     summary.paths.push_back(p);
   }
   summary.paths.push_back(gt);

@@ -2,7 +2,6 @@
 // scene by the file's extension.
 #include "sim/mesh_scene.h"
 
-#include <filesystem>
 #include <utility>
 
 #include "io/map_io.h"
@@ -27,10 +26,6 @@ SurfaceImages MeshScene::Render(const PinholeCamera& camera, const Pose3f& T_W_C
   s.depth = std::move(r.depth);  // vertices and normals follow from depth in Shade
   if (has_colour_) s.color = std::move(r.color);
   return s;
-}
-
-bool IsMapPath(const std::string& path) {
-  return std::filesystem::path(path).extension() == ".vpmap";
 }
 
 Result<std::unique_ptr<SurfaceScene>> LoadSurfaceScene(const std::string& path,

@@ -28,10 +28,8 @@ class MeshScene : public SurfaceScene {
   Eigen::AlignedBox3f bounds_;
 };
 
-// Whether LoadSurfaceScene reads `path` as a map: a .vpmap file.
-bool IsMapPath(const std::string& path);
-// A map (a MapScene with `map_params`; one without blocks is refused) or a mesh file (ReadMesh,
-// then a MeshScene). Errors are the readers' and Embree's.
+// A map (IsMapPath, io/map_io.h: a MapScene with `map_params`; one without blocks is refused) or a
+// mesh file (ReadMesh, then a MeshScene). Errors are the readers' and Embree's.
 Result<std::unique_ptr<SurfaceScene>> LoadSurfaceScene(const std::string& path,
                                                        const MapSceneParams& map_params);
 

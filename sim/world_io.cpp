@@ -109,7 +109,7 @@ Status WriteInstanceTable(const World& world, const std::string& path) {
     }
     out += "\n";
   }
-  return WriteAtomically(path, [&](const std::string& tmp) { return WriteStringToFile(tmp, out); });
+  return WriteFileAtomically(path, out);
 }
 
 Status WriteRoomTable(const std::vector<Room>& rooms, const std::string& path) {
@@ -118,7 +118,7 @@ Status WriteRoomTable(const std::vector<Room>& rooms, const std::string& path) {
     out += Clean(r.name) + "\t" + Num(r.footprint_W.min().x()) + "\t" +
            Num(r.footprint_W.min().y()) + "\t" + Num(r.footprint_W.max().x()) + "\t" +
            Num(r.footprint_W.max().y()) + "\n";
-  return WriteAtomically(path, [&](const std::string& tmp) { return WriteStringToFile(tmp, out); });
+  return WriteFileAtomically(path, out);
 }
 
 Result<std::vector<Room>> ReadRoomTable(const std::string& path) {
@@ -180,7 +180,7 @@ Status WriteFloorPlanYaml(const FloorPlan& plan, const FloorPlanParams& params,
   out += "width: " + std::to_string(plan.width) + "\nheight: " + std::to_string(plan.height) + "\n";
   out += "min_z: " + Num(params.min_z_m) + "\nmax_z: " + Num(params.max_z_m) + "\n";
   out += "free_value: 255\nobstacle_value: 0\noutside_value: 128\n";
-  return WriteAtomically(path, [&](const std::string& tmp) { return WriteStringToFile(tmp, out); });
+  return WriteFileAtomically(path, out);
 }
 
 Result<WrittenWorld> WriteWorld(const World& world_in, const std::string& out_dir,

@@ -206,10 +206,14 @@ Result<PinholeCamera> ParseIntrinsics(const std::string& text) {
   return camera;
 }
 
+nlohmann::json CameraJson(const PinholeCamera& c) {
+  return {{"width", c.width},           {"height", c.height},         {"fx", ShortestDouble(c.fx)},
+          {"fy", ShortestDouble(c.fy)}, {"cx", ShortestDouble(c.cx)}, {"cy", ShortestDouble(c.cy)}};
+}
+
 Status WriteJsonFile(const nlohmann::json& json, const std::string& path) {
   const std::string text = json.dump(2) + "\n";
-  return WriteAtomically(
-      path, [&](const std::string& tmp_path) { return WriteStringToFile(tmp_path, text); });
+  return WriteFileAtomically(path, text);
 }
 
 void PrintJsonLine(const nlohmann::json& json) { std::cout << json.dump() << std::endl; }

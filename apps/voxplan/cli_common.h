@@ -124,6 +124,9 @@ Result<PinholeCamera> ParseIntrinsics(const std::string& text);
 void AddMapStats(nlohmann::json& j, const TsdfVolume& volume);
 void AddMeshStats(nlohmann::json& j, const Mesh& mesh, double mesh_ms);
 
+// The camera as every command reports it: size and intrinsics.
+nlohmann::json CameraJson(const PinholeCamera& camera);
+
 // Writes JSON (pretty) through WriteAtomically; the error names the file.
 Status WriteJsonFile(const nlohmann::json& json, const std::string& path);
 // The machine-readable result: one JSON object as the last line of stdout.

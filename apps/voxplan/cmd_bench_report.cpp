@@ -7,6 +7,7 @@
 #include <optional>
 #include <sstream>
 
+#include "apps/voxplan/cli_common.h"
 #include "bench/harness/measure.h"
 #include "core/volume.h"
 #include "io/text_file.h"
@@ -152,9 +153,7 @@ json BenchJson(const BenchOptions& o, const bench::FusionBenchParams& fp, const 
   j["raycast_kernel"] = RaycastKernelName(fp.raycast);
   j["raycast_views"] = result.raycast_poses.size();
   j["raycast_pose_indexes"] = result.raycast_poses;
-  j["camera"] = {{"width", info.camera.width},           {"height", info.camera.height},
-                 {"fx", ShortestDouble(info.camera.fx)}, {"fy", ShortestDouble(info.camera.fy)},
-                 {"cx", ShortestDouble(info.camera.cx)}, {"cy", ShortestDouble(info.camera.cy)}};
+  j["camera"] = CameraJson(info.camera);
   j["vs_open3d"] = o.vs_open3d;
   j["machine"] = {{"nproc", bench::Nproc()}, {"cpu_model", bench::CpuModel()}};
   // The top level repeats the largest thread count's row.

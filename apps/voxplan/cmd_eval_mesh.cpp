@@ -177,10 +177,7 @@ int RunEvalMesh(const EvalMeshOptions& o) {
     j["observable_poses"] = views->T_W_C.size();
     j["observable_poses_total"] = views->poses_total;
     j["observable_stride"] = o.observable_stride;
-    j["camera"] = {
-        {"width", views->camera.width},           {"height", views->camera.height},
-        {"fx", ShortestDouble(views->camera.fx)}, {"fy", ShortestDouble(views->camera.fy)},
-        {"cx", ShortestDouble(views->camera.cx)}, {"cy", ShortestDouble(views->camera.cy)}};
+    j["camera"] = CameraJson(views->camera);
     j["min_depth_m"] = o.min_depth_m;
     j["max_depth_m"] = o.max_depth_m;
   } else {

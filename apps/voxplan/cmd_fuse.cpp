@@ -76,9 +76,7 @@ nlohmann::json FuseStats(const FuseOptions& o, const DatasetInfo& info,
   j["weighting"] = o.weighting;
   j["threads"] = MaxThreads();
   j["kernel"] = KernelName(ResolveKernel(params.kernel));
-  j["camera"] = {{"width", info.camera.width},           {"height", info.camera.height},
-                 {"fx", ShortestDouble(info.camera.fx)}, {"fy", ShortestDouble(info.camera.fy)},
-                 {"cx", ShortestDouble(info.camera.cx)}, {"cy", ShortestDouble(info.camera.cy)}};
+  j["camera"] = CameraJson(info.camera);
   j["depth_scale"] = info.depth_scale;
   j["integrate_ms_median"] = RoundTo(integrate_t.median, 3);
   j["integrate_ms_p90"] = RoundTo(integrate_t.p90, 3);

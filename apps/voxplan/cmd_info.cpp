@@ -50,9 +50,7 @@ int DatasetInfoCommand(const InfoOptions& o) {
   j["root"] = info.root;
   j["format"] = DatasetFormatName(info.format);
   j["frames"] = info.num_frames;
-  j["camera"] = {{"width", c.width},           {"height", c.height},
-                 {"fx", ShortestDouble(c.fx)}, {"fy", ShortestDouble(c.fy)},
-                 {"cx", ShortestDouble(c.cx)}, {"cy", ShortestDouble(c.cy)}};
+  j["camera"] = CameraJson(c);
   j["intrinsics_source"] = info.intrinsics_source;
   j["depth_scale"] = info.depth_scale;
   j["pose_source"] = info.pose_source;

@@ -10,6 +10,7 @@
 #include "apps/voxplan/cli_common.h"
 #include "core/parallel.h"
 #include "io/image_io.h"
+#include "io/map_io.h"
 #include "io/mesh_io.h"
 #include "sim/mesh_scene.h"
 #include "viewer_offscreen/render_views.h"

@@ -46,8 +46,7 @@ Status WriteInstanceClasses(const World& world, const std::string& path) {
   std::string text = "id\tclass\tmodel\n";
   for (const Instance& inst : world.instances)
     text += std::to_string(inst.id) + "\t" + inst.class_name + "\t" + inst.model + "\n";
-  return WriteAtomically(path,
-                         [&](const std::string& tmp) { return WriteStringToFile(tmp, text); });
+  return WriteFileAtomically(path, text);
 }
 
 int RunSimRender(const SimRenderOptions& o) {
@@ -121,12 +120,7 @@ int RunSimRender(const SimRenderOptions& o) {
   j["trajectory"] = o.trajectory;
   j["out"] = o.out_dir;
   j["frames"] = summary->frames;
-  j["camera"] = {{"width", width},
-                 {"height", height},
-                 {"fx", ShortestDouble(options.camera.fx)},
-                 {"fy", ShortestDouble(options.camera.fy)},
-                 {"cx", ShortestDouble(options.camera.cx)},
-                 {"cy", ShortestDouble(options.camera.cy)}};
+  j["camera"] = CameraJson(options.camera);
   j["noise"] = options.noise;
   j["seed"] = o.seed;
   j["valid_depth_fraction"] = RoundTo(summary->valid_depth_fraction, 4);
