@@ -58,6 +58,13 @@ void BlockMap::Reserve(size_t n) {
   if (want > keys_.size()) Rehash(want);
 }
 
+size_t BlockMap::PeakBytesWith(size_t n) const {
+  size_t capacity = keys_.size();
+  if (n * 2 <= capacity) return capacity_bytes();
+  while (n * 2 > capacity) capacity = std::max<size_t>(64, capacity * 2);
+  return (capacity + capacity / 2) * kBytesPerSlot;  // the new arrays beside the old
+}
+
 void BlockMap::Clear() {
   keys_.clear();
   slots_.clear();

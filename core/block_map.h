@@ -21,6 +21,10 @@ class BlockMap {
   void Reserve(size_t n);
   void Clear();
   size_t size() const { return size_; }
+  // Bytes of the table's arrays now, and at most while holding n entries (a table that grows
+  // holds its old arrays beside the new ones until they are rehashed).
+  size_t capacity_bytes() const { return keys_.size() * kBytesPerSlot; }
+  size_t PeakBytesWith(size_t n) const;
 
   template <typename F>  // f(BlockIndex, slot), in table order (not sorted)
   void ForEach(F&& f) const {
@@ -32,6 +36,7 @@ class BlockMap {
 
  private:
   static constexpr uint64_t kEmpty = ~0ull;
+  static constexpr size_t kBytesPerSlot = sizeof(uint64_t) + sizeof(uint32_t);
   static uint64_t Hash(uint64_t k) {  // splitmix64 finaliser
     k ^= k >> 30;
     k *= 0xbf58476d1ce4e5b9ull;

@@ -22,7 +22,12 @@ class BlockPool {
     return chunks_[slot / kChunkBlocks][slot % kChunkBlocks];
   }
   size_t live() const { return next_ - free_.size(); }
-  size_t capacity_bytes() const { return chunks_.size() * kChunkBlocks * sizeof(TsdfBlock); }
+  size_t capacity_bytes() const { return chunks_.size() * chunk_bytes(); }
+  static constexpr size_t chunk_bytes() { return kChunkBlocks * sizeof(TsdfBlock); }
+  // True when the next Allocate() adds a chunk (no free slot, every chunk full).
+  bool AllocateNeedsChunk() const {
+    return free_.empty() && next_ / kChunkBlocks >= chunks_.size();
+  }
 
  private:
   std::vector<std::unique_ptr<TsdfBlock[]>> chunks_;

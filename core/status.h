@@ -15,6 +15,7 @@ enum class StatusCode {
   kIoError,
   kCorruptData,
   kUnsupported,
+  kResourceExhausted,  // a budget (memory) was reached
   kInternal
 };
 
@@ -48,6 +49,9 @@ inline Status NotFound(std::string m) { return {StatusCode::kNotFound, std::move
 inline Status IoError(std::string m) { return {StatusCode::kIoError, std::move(m)}; }
 inline Status CorruptData(std::string m) { return {StatusCode::kCorruptData, std::move(m)}; }
 inline Status Unsupported(std::string m) { return {StatusCode::kUnsupported, std::move(m)}; }
+inline Status ResourceExhausted(std::string m) {
+  return {StatusCode::kResourceExhausted, std::move(m)};
+}
 
 template <typename T>
 class [[nodiscard]] Result {

@@ -9,6 +9,7 @@
 #include <sstream>
 #include <utility>
 
+#include "core/bounds.h"
 #include "core/queries.h"
 #include "explore/explore_world.h"
 #include "planning/integrate_planning.h"
@@ -80,8 +81,8 @@ class Explorer {
         p_(params),
         probe_(probe),
         progress_(progress),
-        volume_(std::make_unique<TsdfVolume>(
-            VolumeParams{params.voxel_size_m, params.trunc_vox * params.voxel_size_m})),
+        volume_(std::make_unique<TsdfVolume>(VolumeParams{
+            params.voxel_size_m, params.trunc_vox * params.voxel_size_m, params.max_memory_bytes})),
         map_(*volume_),
         floor_(std::make_unique<FloorMap>(params.voxel_size_m, params.floor)),
         explore_world_(map_, *floor_, ExploreWorldParams{}) {}
@@ -729,10 +730,9 @@ Result<ExploreResult> Explorer::Run(const std::vector<Eigen::Vector2f>& starts) 
 }  // namespace
 
 Status ExploreParams::Validate() const {
-  if (!(voxel_size_m > 0.f)) return InvalidArgument("explore: voxel_size_m must be > 0");
-  if (!(trunc_vox >= 1.f)) return InvalidArgument("explore: trunc_vox must be >= 1");
-  if (image_width <= 0 || image_height <= 0)
-    return InvalidArgument("explore: image size must be positive");
+  const VolumeParams volume{voxel_size_m, trunc_vox * voxel_size_m, max_memory_bytes};
+  VOXPLAN_RETURN_IF_ERROR(volume.Validate().WithContext("explore"));
+  VOXPLAN_RETURN_IF_ERROR(bounds::CheckImageSize("explore: image size", image_width, image_height));
   if (!(step_s > 0.0)) return InvalidArgument("explore: step_s must be > 0");
   if (!(planning_interval_s > 0.0))
     return InvalidArgument("explore: planning_interval_s must be > 0");

@@ -48,6 +48,7 @@ struct ExploreParams {
   float voxel_size_m = 0.05f;
   float trunc_vox = 3.0f;
   int image_width = 320, image_height = 240;  // 5 cm voxels need no more
+  uint64_t max_memory_bytes = 0;              // the fused map's budget (VolumeParams); 0: none
   bool noise = true;                          // Kinect noise on the rendered depth
   bool fuse_labels = true;                    // instance labels into the object map
   // Vertex colours of the final mesh only (no metric reads them): off saves rendering and

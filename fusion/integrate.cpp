@@ -7,6 +7,7 @@
 #include <mutex>
 #include <string>
 
+#include "core/bounds.h"
 #include "core/parallel.h"
 #include "core/stopwatch.h"
 #include "fusion/integrate_kernel.h"
@@ -49,21 +50,24 @@ void ForEachBlockOnSegment(const Eigen::Vector3f& a, const Eigen::Vector3f& b, f
   }
 }
 
-Status ValidateParams(const IntegrateParams& p) {
-  if (!(p.min_depth_m >= 0.f && p.max_depth_m > p.min_depth_m && std::isfinite(p.max_depth_m)))
-    return InvalidArgument("depth range must satisfy 0 <= min < max, got [" +
-                           std::to_string(p.min_depth_m) + ", " + std::to_string(p.max_depth_m) +
-                           "]");
-  if (p.carve_free_space && !(p.carve_ray_spacing_blocks > 0.f))
-    return InvalidArgument("carve ray spacing must be positive, got " +
-                           std::to_string(p.carve_ray_spacing_blocks));
-  if (!(p.max_weight > 0.f && p.max_weight <= kMaxWeight))
-    return InvalidArgument("max weight must be in (0, " + std::to_string(kMaxWeight) + "], got " +
-                           std::to_string(p.max_weight));
+}  // namespace
+
+Status IntegrateParams::Validate() const {
+  VOXPLAN_RETURN_IF_ERROR(
+      bounds::CheckRange("min depth", min_depth_m, 0.0, bounds::kDepthMaxM, "m"));
+  VOXPLAN_RETURN_IF_ERROR(
+      bounds::CheckRange("max depth", max_depth_m, 0.0, bounds::kDepthMaxM, "m"));
+  if (!(max_depth_m > min_depth_m))
+    return InvalidArgument("depth range must satisfy min < max, got [" +
+                           std::to_string(min_depth_m) + ", " + std::to_string(max_depth_m) + "]");
+  if (carve_free_space)
+    VOXPLAN_RETURN_IF_ERROR(
+        bounds::CheckRange("carve ray spacing", carve_ray_spacing_blocks, 0.01, 16.0, "blocks"));
+  // The range is (0, kMaxWeight]: 0 itself is refused below.
+  VOXPLAN_RETURN_IF_ERROR(bounds::CheckRange("max weight", max_weight, 0.0, kMaxWeight));
+  if (max_weight == 0.f) return InvalidArgument("max weight must be positive");
   return Status::Ok();
 }
-
-}  // namespace
 
 bool SimdKernelAvailable() {
 #if defined(__x86_64__)
@@ -336,6 +340,20 @@ std::vector<BlockIndex> CollectBlocks(const DepthImage& depth, const PinholeCame
   return MergeToSortedBlocks(runs);
 }
 
+// Past the memory budget: keeps the blocks that exist (in band order), so the update and the
+// touched list skip the refused ones.
+void DropRefused(std::vector<BlockIndex>& band, std::vector<TsdfBlock*>& blocks) {
+  size_t kept = 0;
+  for (size_t i = 0; i < band.size(); ++i) {
+    if (!blocks[i]) continue;
+    band[kept] = band[i];
+    blocks[kept] = blocks[i];
+    ++kept;
+  }
+  band.resize(kept);
+  blocks.resize(kept);
+}
+
 }  // namespace
 
 std::vector<BlockIndex> BlocksInTruncationBand(const DepthImage& depth, const PinholeCamera& camera,
@@ -353,8 +371,10 @@ std::vector<BlockIndex> BlocksToUpdate(const DepthImage& depth, const PinholeCam
 Result<IntegrateStats> IntegrateFrame(const DepthImage& depth, const ColorImage& color,
                                       const PinholeCamera& camera, const Pose3f& T_W_C,
                                       const IntegrateParams& params, TsdfVolume& volume) {
-  VOXPLAN_RETURN_IF_ERROR(ValidateParams(params));
+  VOXPLAN_RETURN_IF_ERROR(params.Validate());
+  VOXPLAN_RETURN_IF_ERROR(volume.params().Validate());
   if (!camera.Valid()) return InvalidArgument("camera intrinsics are invalid");
+  VOXPLAN_RETURN_IF_ERROR(bounds::CheckIntrinsics(camera));
   if (depth.width != camera.width || depth.height != camera.height)
     return InvalidArgument("depth image is " + std::to_string(depth.width) + "x" +
                            std::to_string(depth.height) + " but the camera is " +
@@ -377,9 +397,14 @@ Result<IntegrateStats> IntegrateFrame(const DepthImage& depth, const ColorImage&
   });
   for (size_t i = 0; i < band.size(); ++i) {
     if (blocks[i]) continue;
-    blocks[i] = &volume.FindOrAllocate(band[i]);
-    ++stats.blocks_allocated;
+    blocks[i] = volume.AllocateWithinBudget(band[i]);
+    if (blocks[i]) {
+      ++stats.blocks_allocated;
+    } else {
+      ++stats.blocks_refused;
+    }
   }
+  if (stats.blocks_refused > 0) DropRefused(band, blocks);
   stats.blocks_in_band = band.size();
   stats.allocate_ms = clock.ElapsedMs();
 

@@ -37,11 +37,17 @@ struct IntegrateParams {
   // (OctoMap's maxrange). Real sensors return such readings; their noise keeps them out of the
   // model, so they update only voxels still unobserved or free, never a fused surface.
   bool clear_beyond_max_depth = false;
+
+  // Depth range within [0, bounds::kDepthMaxM] with min < max, max weight in (0, kMaxWeight],
+  // a positive carve ray spacing; InvalidArgument naming the value and the range otherwise.
+  Status Validate() const;
 };
 
 struct IntegrateStats {
   size_t blocks_in_band = 0;  // blocks updated this frame (band, plus carved ones when carving)
   size_t blocks_allocated = 0;
+  // New blocks the volume's memory budget refused: their voxels were not updated this frame.
+  size_t blocks_refused = 0;
   size_t valid_pixels = 0;
   double allocate_ms = 0.0;
   double update_ms = 0.0;
@@ -51,7 +57,9 @@ struct IntegrateStats {
 };
 
 // depth: metres, 0 = invalid; color: empty or the same size as depth. Refuses (InvalidArgument)
-// images that do not match the camera and non-finite poses.
+// invalid params (theirs and the volume's Validate()), intrinsics outside core/bounds.h's
+// ranges, images that do not match the camera and non-finite poses. Blocks past the volume's
+// memory budget are left out (IntegrateStats::blocks_refused).
 Result<IntegrateStats> IntegrateFrame(const DepthImage& depth, const ColorImage& color,
                                       const PinholeCamera& camera, const Pose3f& T_W_C,
                                       const IntegrateParams& params, TsdfVolume& volume);

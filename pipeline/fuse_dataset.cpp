@@ -5,6 +5,7 @@
 #include <optional>
 #include <stdexcept>
 
+#include "core/bounds.h"
 #include "core/stopwatch.h"
 
 namespace voxplan {
@@ -45,12 +46,39 @@ class SkipCounter {
   size_t count_ = 0;
 };
 
+// The budget as messages give it: "512 MiB".
+std::string BudgetText(const TsdfVolume& volume) {
+  return std::to_string(volume.params().max_memory_bytes >> 20) + " MiB";
+}
+
+// Counts a frame's refused blocks; the first time warns (or fails, with kFail).
+Status CountOverBudget(const IntegrateStats& stats, const Frame& frame, const FuseParams& params,
+                       const TsdfVolume& volume, const FuseObserver& observer, FuseReport& report) {
+  if (stats.blocks_refused == 0) return Status::Ok();
+  const std::string where = "frame " + std::to_string(frame.index) + " (" + frame.depth_path + ")";
+  if (params.on_memory_limit == OnMemoryLimit::kFail)
+    return ResourceExhausted("memory budget of " + BudgetText(volume) + " reached at " + where +
+                             ": the map holds " + std::to_string(volume.num_blocks()) +
+                             " blocks, " + std::to_string(stats.blocks_refused) +
+                             " more were needed");
+  if (report.frames_over_budget == 0 && observer.warning)
+    observer.warning("memory budget of " + BudgetText(volume) + " reached at " + where +
+                     ": no new blocks from here on (surfaces first seen later are left out; "
+                     "blocks and frames dropped are counted)");
+  report.blocks_refused += stats.blocks_refused;
+  ++report.frames_over_budget;
+  return Status::Ok();
+}
+
 }  // namespace
 
 Result<FuseReport> FuseDataset(const Dataset& dataset, const std::vector<size_t>& indices,
                                const FuseParams& params, TsdfVolume& volume,
                                const FuseObserver& observer) {
   const DatasetInfo& info = dataset.info();
+  VOXPLAN_RETURN_IF_ERROR(params.Validate());
+  VOXPLAN_RETURN_IF_ERROR(volume.params().Validate());
+  VOXPLAN_RETURN_IF_ERROR(bounds::CheckIntrinsics(info.camera));
   std::optional<FrameTracker> tracker;
   if (params.track) {
     try {
@@ -104,6 +132,7 @@ Result<FuseReport> FuseDataset(const Dataset& dataset, const std::vector<size_t>
           IntegrateFrame(frame->depth, frame->color, info.camera, *T_W_C, params.integrate, volume);
       const double integrate_ms = integrate_clock.ElapsedMs();
       if (!stats.ok()) return Naming(stats.status(), *frame);
+      VOXPLAN_RETURN_IF_ERROR(CountOverBudget(*stats, *frame, params, volume, observer, report));
       report.load_ms.push_back(load_ms);
       report.integrate_ms.push_back(integrate_ms);
       report.frame_ms.push_back(load_ms + integrate_ms);

@@ -19,14 +19,23 @@
 
 namespace voxplan {
 
+// What a run does once the volume's memory budget (VolumeParams::max_memory_bytes) is reached.
+enum class OnMemoryLimit {
+  kDrop,  // keep going without new blocks: warn once, count what was dropped
+  kFail,  // stop with a ResourceExhausted status naming the budget
+};
+
 struct FuseParams {
   IntegrateParams integrate;
+  OnMemoryLimit on_memory_limit = OnMemoryLimit::kDrop;
   // Estimate poses by frame-to-model ICP instead of reading them from the dataset.
   bool track = false;
   TrackingParams tracking;
   // Per kind of skipped frame (no depth, no pose, lost tracking): this many frames are named in
   // a warning each; beyond, one warning at the end gives the count.
   int max_skip_warnings = 5;
+
+  Status Validate() const { return integrate.Validate(); }
 };
 
 struct FusedFrame {
@@ -41,6 +50,8 @@ struct FuseReport {
   size_t frames_selected = 0;
   size_t skipped_no_pose = 0, skipped_no_depth = 0;
   size_t frames_lost = 0;  // tracking only: lost, not integrated
+  // Past the memory budget: new blocks not allocated, and the frames that had some.
+  size_t blocks_refused = 0, frames_over_budget = 0;
   // Per integrated frame: decoding, integration, their sum; per tracked frame: tracking.
   std::vector<double> load_ms, integrate_ms, frame_ms, track_ms;
   double loop_s = 0.0;  // the whole loop, skipped frames included
@@ -55,8 +66,10 @@ struct FuseObserver {
 };
 
 // Fuses dataset frames `indices` (in that order) into `volume`. Fails, naming the frame and its
-// file, when a frame cannot be loaded, integrated or tracked; an invalid camera for tracking is
-// refused. An empty report (no frame integrated) is not a failure: the caller decides.
+// file, when a frame cannot be loaded, integrated or tracked; invalid params (Validate(), the
+// volume's too) and a camera outside core/bounds.h's intrinsics ranges are refused before any
+// frame is read. Past the volume's memory budget: see OnMemoryLimit (one warning when dropping). An
+// empty report (no frame integrated) is not a failure: the caller decides.
 Result<FuseReport> FuseDataset(const Dataset& dataset, const std::vector<size_t>& indices,
                                const FuseParams& params, TsdfVolume& volume,
                                const FuseObserver& observer = {});

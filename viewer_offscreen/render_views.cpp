@@ -6,11 +6,30 @@
 #include <cmath>
 #include <utility>
 
+#include "core/bounds.h"
 #include "core/camera.h"
 
 namespace voxplan {
 
+Status RenderViewsParams::Validate() const {
+  VOXPLAN_RETURN_IF_ERROR(bounds::CheckImageSize("render size", width, height));
+  VOXPLAN_RETURN_IF_ERROR(bounds::CheckRange("field of view", fov_deg, 1.0, 179.0, "degrees"));
+  VOXPLAN_RETURN_IF_ERROR(bounds::CheckRange("orbit views", orbit_views, 1, 3600));
+  VOXPLAN_RETURN_IF_ERROR(
+      bounds::CheckRange("orbit elevation", orbit_elevation_deg, -90.0, 90.0, "degrees"));
+  if (orbit_radius_m)
+    VOXPLAN_RETURN_IF_ERROR(bounds::CheckRange("orbit radius", *orbit_radius_m, 1e-3, 1e4, "m"));
+  if (orbit_height_m)
+    VOXPLAN_RETURN_IF_ERROR(bounds::CheckRange("orbit height", *orbit_height_m, -1e4, 1e4, "m"));
+  if (!up_W.allFinite() || up_W.norm() < 1e-6f)
+    return InvalidArgument("up axis must be a finite non-zero vector");
+  if (T_W_C && !T_W_C->matrix().allFinite())
+    return InvalidArgument("render pose has NaN or infinite values");
+  return Status::Ok();
+}
+
 Result<RenderedViews> RenderViews(const SurfaceScene& scene, const RenderViewsParams& params) {
+  VOXPLAN_RETURN_IF_ERROR(params.Validate());
   RenderedViews views;
   const PinholeCamera camera = CameraFromFov(params.width, params.height, params.fov_deg);
   views.bounds_W = scene.Bounds();

@@ -26,6 +26,10 @@ struct RenderViewsParams {
   std::optional<float> orbit_radius_m;  // across the up axis; unset: framed on the bounds
   std::optional<float> orbit_height_m;  // along the up axis; unset: framed on the bounds
   float orbit_elevation_deg = 35.0f;    // of the framing
+
+  // Image size within core/bounds.h's, field of view in [1, 179] degrees, 1 to 3600 orbit
+  // views, finite orbit numbers and pose; InvalidArgument naming the value otherwise.
+  Status Validate() const;
 };
 
 struct RenderedViews {
@@ -36,7 +40,7 @@ struct RenderedViews {
   double hit_fraction = 0.0;  // mean over the views of the share of pixels on a surface
 };
 
-// Renders and shades every view; fails only when shading refuses an image.
+// Renders and shades every view; fails when the params are invalid or shading refuses an image.
 Result<RenderedViews> RenderViews(const SurfaceScene& scene, const RenderViewsParams& params);
 
 }  // namespace voxplan

@@ -12,6 +12,7 @@
 #include <numeric>
 #include <sstream>
 
+#include "core/bounds.h"
 #include "io/file_util.h"
 #include "io/mesh_io.h"
 
@@ -24,7 +25,7 @@ void AddSceneFrameOptions(CLI::App* sub, SceneFrameOptions& frame) {
       ->check(CLI::IsMember({"z", "y", "Z", "Y"}))
       ->capture_default_str();
   sub->add_option("--scale", frame.scale, "Scene scale to metres")
-      ->check(Positive())
+      ->check(InRange(1e-6, 1e6))
       ->capture_default_str();
 }
 
@@ -61,21 +62,21 @@ void AddDatasetInputOptions(CLI::App* sub, DatasetInput& in, bool with_start) {
       ->check(CLI::IsMember({"auto", "tum", "icl", "redwood", "7scenes", "3dmatch", "replica"}))
       ->capture_default_str();
   sub->add_option("--min-depth", in.min_depth_m, "Ignore depth below this (m)")
-      ->check(NonNegative())
+      ->check(InRange(0.0, bounds::kDepthMaxM, "m"))
       ->capture_default_str();
   sub->add_option("--max-depth", in.max_depth_m, "Ignore depth beyond this (m)")
-      ->check(Positive())
+      ->check(InRange(0.0, bounds::kDepthMaxM, "m"))
       ->capture_default_str();
   sub->add_option("--frames", in.frames, "Frames to use (0: all)")
-      ->check(NonNegative())
+      ->check(FrameCount())
       ->capture_default_str();
   if (with_start) {
     sub->add_option("--start", in.start, "First frame (0-based)")
-        ->check(NonNegative())
+        ->check(IntInRange(0, bounds::kFramesMax))
         ->capture_default_str();
   }
   sub->add_option("--stride", in.stride, "Use every K-th frame")
-      ->check(CLI::Range(int64_t(1), int64_t(1) << 30))
+      ->check(Stride())
       ->capture_default_str();
 }
 
@@ -97,6 +98,13 @@ int OpenDatasetInput(const DatasetInput& in, DatasetOptions options, OpenedDatas
   if (!opened.ok()) return Fail(MessageNaming(opened.status(), in.dataset));
   const DatasetInfo& info = (*opened)->info();
   for (const std::string& w : info.warnings) Warn(w);
+  if (Status s = bounds::CheckIntrinsics(info.camera); !s.ok()) {
+    // Named by where the intrinsics came from: the flag or the dataset's camera file.
+    const std::string& source =
+        info.intrinsics_source.empty() ? in.dataset : info.intrinsics_source;
+    return Fail((options.intrinsics ? std::string("--intrinsics") : source) + ": " + s.message(),
+                kExitUsage);
+  }
   out->indices.clear();
   for (size_t i = size_t(in.start); i < info.num_frames; i += size_t(in.stride)) {
     if (in.frames > 0 && out->indices.size() == size_t(in.frames)) break;

@@ -10,6 +10,7 @@
 #include <string>
 #include <vector>
 
+#include "apps/voxplan/cli_bounds.h"
 #include "apps/voxplan/progress.h"
 #include "core/camera.h"
 #include "core/mesh.h"
@@ -107,9 +108,10 @@ struct OpenedDataset {
   std::unique_ptr<Dataset> dataset;
   std::vector<size_t> indices;  // the selected frames: start, start + stride, ... (at most frames)
 };
-// Refuses a bad depth range, format or folder, opens the dataset (its warnings to stderr) and
-// selects the frames. Returns kExitOk and fills *out, or the exit code after printing why.
-// `options` carries any intrinsics or depth-scale override; its format is set from `in`.
+// Refuses a bad depth range, format or folder, opens the dataset (its warnings to stderr),
+// refuses (usage error) intrinsics outside core/bounds.h's ranges and selects the frames. Returns
+// kExitOk and fills *out, or the exit code after printing why. `options` carries any intrinsics or
+// depth-scale override; its format is set from `in`.
 int OpenDatasetInput(const DatasetInput& in, DatasetOptions options, OpenedDataset* out);
 
 // --kernel of fuse and bench: the integration kernel by name.

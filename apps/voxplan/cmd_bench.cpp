@@ -11,6 +11,7 @@
 #include "apps/voxplan/cmd_bench_report.h"
 #include "bench/harness/fusion_bench.h"
 #include "bench/harness/open3d_runner.h"
+#include "core/bounds.h"
 #include "core/parallel.h"
 #include "fusion/integrate.h"
 #include "io/dataset.h"
@@ -23,7 +24,7 @@ namespace {
 using bench::BenchMode;
 using nlohmann::json;
 
-constexpr int kMaxThreadCount = 4096;
+constexpr int kMaxThreadCount = bounds::kThreadsMax;
 
 Result<std::vector<int>> ParseThreadList(const std::string& text) {
   std::vector<int> threads;
@@ -61,7 +62,8 @@ int RunBench(const BenchOptions& o, BenchMode mode) {
   // Everything the arguments alone can refuse is refused before the dataset is read.
   Result<std::vector<int>> thread_list = ParseThreadList(o.threads);
   if (!thread_list.ok()) return Fail(thread_list.status().message(), kExitUsage);
-  if (o.trunc_m < o.voxel_size_m) return Fail("--trunc must be at least --voxel-size", kExitUsage);
+  if (std::string why = CheckVoxelAndTrunc(o.voxel_size_m, o.trunc_m); !why.empty())
+    return Fail(why, kExitUsage);
   if (o.in.max_depth_m <= o.in.min_depth_m) {
     return Fail("--max-depth must be greater than --min-depth", kExitUsage);
   }
@@ -81,7 +83,7 @@ int RunBench(const BenchOptions& o, BenchMode mode) {
   params.kernel = kIntegrationKernels.at(o.kernel);
   bench::FusionBenchParams fp;
   fp.mode = mode;
-  fp.volume = {float(o.voxel_size_m), float(o.trunc_m)};
+  fp.volume = {float(o.voxel_size_m), float(o.trunc_m), MemoryBudgetBytes(o.memory)};
   fp.integrate = params;
   fp.raycast.max_depth_m = float(o.in.max_depth_m);
   fp.raycast.simd = params.kernel != Kernel::kScalar;
@@ -119,10 +121,11 @@ int RunBench(const BenchOptions& o, BenchMode mode) {
 void AddBenchOptions(CLI::App* sub, BenchOptions& o) {
   AddDatasetInputOptions(sub, o.in);
   sub->add_option("--voxel-size", o.voxel_size_m, "Voxel size in metres")
-      ->check(Positive())
+      ->check(VoxelSize())
       ->capture_default_str();
-  sub->add_option("--trunc", o.trunc_m, "Truncation distance in metres")
-      ->check(Positive())
+  sub->add_option("--trunc", o.trunc_m, "Truncation distance in metres (1 to 64 voxels)")
+      ->check(InRange(bounds::kVoxelSizeMinM * bounds::kTruncMinVoxels,
+                      bounds::kVoxelSizeMaxM * bounds::kTruncMaxVoxels, "m"))
       ->capture_default_str();
   sub->add_option("--threads", o.threads,
                   "Comma-separated thread counts, one row each (default: 1 and all)");
@@ -137,6 +140,7 @@ void AddBenchOptions(CLI::App* sub, BenchOptions& o) {
   sub->add_flag("--vs-open3d", o.vs_open3d,
                 "Also run Open3D (legacy and VoxelBlockGrid) on the same frames");
   sub->add_option("--json", o.json_path, "Write the result JSON")->check(OutputFileValidator());
+  AddMemoryBudgetOptions(sub, o.memory, /*with_on_limit=*/false);
 }
 
 }  // namespace

@@ -7,6 +7,7 @@
 
 #include "apps/voxplan/cli_common.h"
 #include "bench/harness/maps_bench.h"
+#include "core/bounds.h"
 #include "io/dataset.h"
 #include "io/text_file.h"
 #include "planning/octomap_export.h"
@@ -106,13 +107,13 @@ Command AddBenchMapsCommand(CLI::App& bench) {
   o->in.frames = 30;
   AddDatasetInputOptions(sub, o->in);
   sub->add_option("--resolution", o->resolution_m, "Planning voxel size in metres")
-      ->check(CLI::Range(0.005, 1.0))
+      ->check(InRange(0.005, 1.0, "m"))
       ->capture_default_str();
   sub->add_option("--trunc-vox", o->trunc_vox, "Truncation distance in voxels")
-      ->check(CLI::Range(1.0, 64.0))
+      ->check(InRange(bounds::kTruncMinVoxels, bounds::kTruncMaxVoxels, "voxels"))
       ->capture_default_str();
   sub->add_option("--threads", o->threads, "Threads for the planning map")
-      ->check(CLI::Range(1, 4096))
+      ->check(IntInRange(1, bounds::kThreadsMax))
       ->capture_default_str();
   sub->add_flag("--vs-octomap", o->vs_octomap,
                 "Also time OctoMap's insertPointCloud on the same frames");

@@ -22,6 +22,7 @@ struct BenchOptions {
   std::string kernel = "auto";
   bool vs_open3d = false;
   std::string json_path;
+  MemoryBudgetOptions memory;  // --max-memory of the volume
 };
 
 // "avx2" or "scalar": the ray-casting kernel `params` gets on this CPU.

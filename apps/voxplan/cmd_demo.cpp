@@ -29,6 +29,7 @@ struct DemoOptions {
   int frames = kDemoFrames;
   double voxel_size_m = 0.02;
   int threads = 0;
+  MemoryBudgetOptions memory;
 };
 
 // The targets the demo is meant to meet, in voxels of the chosen size.
@@ -75,7 +76,8 @@ int RunDemo(const DemoOptions& o) {
   if (!raycaster.ok()) return Fail("raycaster: " + raycaster.status().message());
 
   const double trunc_m = kTruncVoxels * o.voxel_size_m;
-  TsdfVolume volume(VolumeParams{float(o.voxel_size_m), float(trunc_m)});
+  TsdfVolume volume(
+      VolumeParams{float(o.voxel_size_m), float(trunc_m), MemoryBudgetBytes(o.memory)});
   IntegrateParams params;
   params.min_depth_m = 0.1f;
   // Noise-free renders: every wall of the room is worth integrating.
@@ -188,14 +190,15 @@ Command AddDemoCommand(CLI::App& app) {
       "demo", "Render a synthetic room, fuse it, mesh it and score the mesh (no data needed)");
   sub->add_option("--out", o->out_dir, "Output folder")->capture_default_str();
   sub->add_option("--frames", o->frames, "Frames along the demo trajectory")
-      ->check(CLI::Range(1, 100000))
+      ->check(IntInRange(1, 100000))
       ->capture_default_str();
   sub->add_option("--voxel-size", o->voxel_size_m, "Voxel size in metres")
-      ->check(Positive())
+      ->check(VoxelSize())
       ->capture_default_str();
   sub->add_option("--threads", o->threads, "Worker threads (0: all hardware threads)")
-      ->check(NonNegative())
+      ->check(ThreadCount())
       ->capture_default_str();
+  AddMemoryBudgetOptions(sub, o->memory, /*with_on_limit=*/false);
   return {sub, [o] { return RunDemo(*o); }};
 }
 

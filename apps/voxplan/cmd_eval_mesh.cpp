@@ -7,6 +7,7 @@
 #include <optional>
 
 #include "apps/voxplan/cli_common.h"
+#include "core/bounds.h"
 #include "core/parallel.h"
 #include "eval/eval_mesh.h"
 #include "eval/visibility.h"
@@ -63,6 +64,7 @@ Result<ObservableViews> ReadObservableViews(const EvalMeshOptions& o) {
     if (!dataset.ok()) return dataset.status();  // its messages name the file
     const DatasetInfo& info = (*dataset)->info();
     views.camera = info.camera;
+    VOXPLAN_RETURN_IF_ERROR(bounds::CheckIntrinsics(views.camera).Naming(o.observable_from));
     views.poses_total = info.num_frames;
     // Loading decodes the images too; only the kept frames are loaded.
     for (size_t i = 0; i < info.num_frames; i += size_t(o.observable_stride)) {
@@ -79,13 +81,15 @@ Result<ObservableViews> ReadObservableViews(const EvalMeshOptions& o) {
                     o.observable_from);
   int width = 0, height = 0, consumed = 0;
   if (std::sscanf(o.size.c_str(), "%dx%d%n", &width, &height, &consumed) != 2 ||
-      consumed != int(o.size.size()) || width <= 0 || height <= 0 || width > 8192 || height > 8192)
+      consumed != int(o.size.size()))
     return InvalidArgument("--size wants WIDTHxHEIGHT (e.g. 640x480), got '" + o.size + "'");
+  VOXPLAN_RETURN_IF_ERROR(bounds::CheckImageSize("--size", width, height));
   // sim render's defaults: fx = fy = 525, principal point at the image centre.
   views.camera = intrinsics.value_or(
       PinholeCamera{0, 0, 525.f, 525.f, 0.5f * float(width - 1), 0.5f * float(height - 1)});
   views.camera.width = width;
   views.camera.height = height;
+  VOXPLAN_RETURN_IF_ERROR(bounds::CheckIntrinsics(views.camera));
   Result<TumTrajectory> trajectory = ReadTumTrajectory(o.observable_from);
   if (!trajectory.ok()) return trajectory.status();  // path:line: ...
   views.poses_total = trajectory->T_W_C.size();
@@ -204,20 +208,20 @@ Command AddEvalMeshCommand(CLI::App& eval) {
   sub->add_option("reconstruction", o->reconstruction, "Reconstructed mesh")->required();
   sub->add_option("ground-truth", o->ground_truth, "Ground-truth mesh")->required();
   sub->add_option("--threshold", o->threshold_m, "Completeness distance threshold (m)")
-      ->check(Positive())
+      ->check(InRange(1e-4, 10.0, "m"))
       ->capture_default_str();
   sub->add_option("--samples-per-m2", o->samples_per_m2, "Surface samples per square metre")
-      ->check(Positive())
+      ->check(InRange(1.0, 1e6))
       ->capture_default_str();
   sub->add_option("--seed", o->seed, "Sampling seed")->capture_default_str();
   sub->add_option("--gt-up", o->gt_up, "Up axis of the ground-truth file (y rotates to Z-up)")
       ->check(CLI::IsMember({"y", "z"}))
       ->capture_default_str();
   sub->add_option("--gt-scale", o->gt_scale, "Scale applied to the ground truth")
-      ->check(Positive())
+      ->check(InRange(1e-6, 1e6))
       ->capture_default_str();
   sub->add_option("--threads", o->threads, "Worker threads (0: all hardware threads)")
-      ->check(NonNegative())
+      ->check(ThreadCount())
       ->capture_default_str();
   sub->add_option("--observable-from", o->observable_from,
                   "Score completeness on the surface these poses could see: a dataset folder "
@@ -234,11 +238,11 @@ Command AddEvalMeshCommand(CLI::App& eval) {
       ->capture_default_str();
   sub->add_option("--min-depth", o->min_depth_m,
                   "With --observable-from: nearest depth that was fused (m), as given to fuse")
-      ->check(NonNegative())
+      ->check(InRange(0.0, bounds::kDepthMaxM, "m"))
       ->capture_default_str();
   sub->add_option("--max-depth", o->max_depth_m,
                   "With --observable-from: farthest depth that was fused (m), as given to fuse")
-      ->check(Positive())
+      ->check(InRange(0.0, bounds::kDepthMaxM, "m"))
       ->capture_default_str();
   return {sub, [o] { return RunEvalMesh(*o); }};
 }

@@ -123,27 +123,27 @@ Command AddEvalObjectsCommand(CLI::App& eval) {
   objects->add_option("reconstruction", o->reconstruction, "Reconstructed mesh")->required();
   AddSceneOptions(objects, &o->scene, /*required=*/true);
   objects->add_option("--threshold", o->threshold_m, "Completeness distance threshold (m)")
-      ->check(Positive())
+      ->check(InRange(1e-4, 10.0, "m"))
       ->capture_default_str();
   objects->add_option("--samples-per-m2", o->samples_per_m2, "Surface samples per square metre")
-      ->check(Positive())
+      ->check(InRange(1.0, 1e6))
       ->capture_default_str();
   objects->add_option("--min-samples", o->min_samples, "Fewest ground-truth samples per object")
-      ->check(CLI::PositiveNumber)
+      ->check(IntInRange(1, int64_t(1) << 30))
       ->capture_default_str();
   objects->add_option("--seed", o->seed, "Sampling seed")->capture_default_str();
   objects
       ->add_option("--max-attribution", o->max_attribution_m,
                    "Reconstruction farther than this (m) from all ground truth belongs to no "
                    "object (0: no limit)")
-      ->check(NonNegative())
+      ->check(InRange(0.0, 1e4, "m"))
       ->capture_default_str();
   objects
       ->add_option("--exclude-classes", o->exclude,
                    "Comma-separated instance classes that are not objects (empty: none)")
       ->capture_default_str();
   objects->add_option("--threads", o->threads, "Worker threads (0: all hardware threads)")
-      ->check(NonNegative())
+      ->check(ThreadCount())
       ->capture_default_str();
   return {objects, [o] { return RunEvalObjects(*o); }};
 }

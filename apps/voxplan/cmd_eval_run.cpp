@@ -113,11 +113,11 @@ Command AddEvalRunCommand(CLI::App& eval) {
       ->required();
   CLI::Option* area = run->add_option("--floor-area", r->floor_area_m2,
                                       "Scene floor area (m²) for distance per area")
-                          ->check(Positive());
+                          ->check(InRange(0.01, 1e6, "m²"));
   AddSceneOptions(run, &r->scene, /*required=*/false);
   run->get_option("--scene")->excludes(area);
   run->add_option("--resolution", r->resolution_m, "Floor plan cell size with --scene (m)")
-      ->check(Positive())
+      ->check(InRange(0.01, 1.0, "m"))
       ->capture_default_str();
   run->add_option("--csv", r->csv, "Write distance and busy robots over time here")
       ->check(OutputFileValidator());

@@ -71,7 +71,7 @@ Command AddEvalTrajectoryCommand(CLI::App& eval) {
       ->required();
   traj->add_option("reference", t->reference, "Reference trajectory (TUM format)")->required();
   traj->add_option("--max-dt", t->max_dt_s, "Largest timestamp difference to associate (s)")
-      ->check(NonNegative())
+      ->check(InRange(0.0, 1e6, "s"))
       ->capture_default_str();
   return {traj, [t] { return RunEvalTrajectory(*t); }};
 }

@@ -50,6 +50,7 @@ struct ExploreOptions {
   bool no_clear = false;
   double fuse_step_m = 0.25, fuse_step_deg = 15.0;
   int threads = 0;
+  MemoryBudgetOptions memory;
 };
 
 std::string Join(const std::vector<std::string>& items) {
@@ -122,6 +123,7 @@ ExploreRunParams RunParams(const ExploreOptions& o, std::vector<Eigen::Vector2f>
   run.starts = std::move(starts);
   ExploreParams& params = run.explore;
   params.voxel_size_m = float(o.voxel_size);
+  params.max_memory_bytes = MemoryBudgetBytes(o.memory);
   params.noise = !o.no_noise;
   params.fuse_labels = !o.no_labels;
   params.fuse_color = !o.no_color;
@@ -180,29 +182,36 @@ Command AddExploreCommand(CLI::App& app) {
   CLI::App* sub = app.add_subcommand(
       "explore", "Closed-loop multi-robot exploration of a simulated scene with a planner plugin");
   auto positive = [sub](const char* name, double& value, const char* help) {
-    sub->add_option(name, value, help)->check(Positive())->capture_default_str();
+    sub->add_option(name, value, help)->check(InRange(1e-6, 1e6))->capture_default_str();
   };
   sub->add_option("--scene", run.scene,
                   "apartment:size=S|M|L,seed=N, or a scene file (.ply .glb .obj .dae), Z-up metres "
                   "by default")
       ->required();
   AddSceneFrameOptions(sub, o->frame);
-  sub->add_option("--robots", run.robots, "Number of robots")->capture_default_str();
+  sub->add_option("--robots", run.robots, "Number of robots")
+      ->check(IntInRange(1, 64))
+      ->capture_default_str();
   sub->add_option("--planner", o->planner, "Planner name (libvoxplan_planner_<name>.so) or path")
       ->required();
   sub->add_option("--planner-config", o->planner_config, "JSON file handed to the planner");
   sub->add_option("--seed", run.explore.seed, "Seed of the planner and the sensor noise")
       ->capture_default_str();
   sub->add_option("--max-time", run.explore.max_time_s, "Simulated seconds before the run stops")
+      ->check(InRange(0.001, 1e6, "s"))
       ->capture_default_str();
   sub->add_option("--start", o->start,
                   "Start positions \"x,y;x,y;...\" in metres, one per robot (default: side by "
                   "side in the largest room)");
   sub->add_option("--out,-o", run.out_dir, "Output folder (created)")->required();
-  positive("--voxel-size", o->voxel_size, "Voxel size of the fused map, metres");
+  sub->add_option("--voxel-size", o->voxel_size, "Voxel size of the fused map, metres")
+      ->check(VoxelSize())
+      ->capture_default_str();
   sub->add_option("--width", run.explore.image_width, "Rendered image width, pixels")
+      ->check(ImageSide())
       ->capture_default_str();
   sub->add_option("--height", run.explore.image_height, "Rendered image height, pixels")
+      ->check(ImageSide())
       ->capture_default_str();
   sub->add_option(
          "--fov-deg", o->fov_deg,
@@ -228,7 +237,8 @@ Command AddExploreCommand(CLI::App& app) {
   positive("--fuse-step-deg", o->fuse_step_deg, "Degrees of camera turn between fused frames");
   positive("--progress-interval", run.explore.progress_interval_s,
            "Simulated seconds between progress lines on stderr");
-  sub->add_option("--threads", o->threads, "Worker threads (0: all)")->check(NonNegative());
+  sub->add_option("--threads", o->threads, "Worker threads (0: all)")->check(ThreadCount());
+  AddMemoryBudgetOptions(sub, o->memory, /*with_on_limit=*/false);
   return {sub, [o] { return RunExploreCommand(*o); }};
 }
 

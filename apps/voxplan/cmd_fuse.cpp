@@ -8,6 +8,7 @@
 #include <sstream>
 
 #include "apps/voxplan/cli_common.h"
+#include "core/bounds.h"
 #include "core/parallel.h"
 #include "core/volume.h"
 #include "fusion/integrate.h"
@@ -40,6 +41,7 @@ struct FuseOptions {
   std::string mesh_path, map_path, stats_path, frame_list_path, trajectory_path;
   bool track = false;
   double photometric_weight = 0.0;
+  MemoryBudgetOptions memory;
 };
 
 nlohmann::json OrNull(const std::string& path) {
@@ -94,17 +96,17 @@ nlohmann::json FuseStats(const FuseOptions& o, const DatasetInfo& info,
   j["map"] = OrNull(o.map_path);
   j["stats"] = OrNull(o.stats_path);
   j["peak_rss_mb"] = PeakRssMb();
+  j["max_memory_mb"] = Mib(volume.params().max_memory_bytes);
+  j["on_memory_limit"] = o.memory.on_limit;
+  j["blocks_refused"] = report.blocks_refused;
+  j["frames_over_budget"] = report.frames_over_budget;
   return j;
 }
 
 int RunFuse(const FuseOptions& o) {
   // Everything the arguments alone can refuse is refused before the dataset is read.
-  if (o.trunc_m < o.voxel_size_m) {
-    std::ostringstream message;
-    message << "--trunc (" << o.trunc_m << ") must be at least --voxel-size (" << o.voxel_size_m
-            << ")";
-    return Fail(message.str(), kExitUsage);
-  }
+  if (std::string why = CheckVoxelAndTrunc(o.voxel_size_m, o.trunc_m); !why.empty())
+    return Fail(why, kExitUsage);
   DatasetOptions dataset_options;
   if (!o.intrinsics.empty()) {
     Result<PinholeCamera> camera = ParseIntrinsics(o.intrinsics);
@@ -126,16 +128,19 @@ int RunFuse(const FuseOptions& o) {
   params.max_weight = float(o.max_weight);
   params.weighting = kWeightings.at(o.weighting);
   params.kernel = kIntegrationKernels.at(o.kernel);
-  TsdfVolume volume(VolumeParams{float(o.voxel_size_m), float(o.trunc_m)});
+  TsdfVolume volume(
+      VolumeParams{float(o.voxel_size_m), float(o.trunc_m), MemoryBudgetBytes(o.memory)});
 
   std::cerr << "fuse: " << info.root << " (" << DatasetFormatName(info.format) << "), "
             << indices.size() << " of " << info.num_frames << " frames, voxel " << o.voxel_size_m
             << " m, trunc " << o.trunc_m << " m, " << MaxThreads() << " threads, kernel "
-            << KernelName(ResolveKernel(params.kernel)) << std::endl;
+            << KernelName(ResolveKernel(params.kernel)) << ", memory budget "
+            << Mib(volume.params().max_memory_bytes) << " MiB" << std::endl;
 
   FuseParams fuse;
   fuse.integrate = params;
   fuse.track = o.track;
+  fuse.on_memory_limit = MemoryLimitAction(o.memory);
   fuse.tracking.photometric_weight = float(o.photometric_weight);
   fuse.tracking.raycast.max_depth_m = float(o.in.max_depth_m);
   fuse.tracking.raycast.min_depth_m = float(o.in.min_depth_m);
@@ -174,6 +179,10 @@ int RunFuse(const FuseOptions& o) {
             << " ms, load median " << j["load_ms_median"] << " ms, " << j["fps"] << " fps\n"
             << "map: " << volume.num_blocks() << " blocks, " << j["map_mb"] << " MiB, peak RSS "
             << j["peak_rss_mb"] << " MiB\n";
+  if (report.blocks_refused > 0) {
+    std::cerr << "memory budget " << j["max_memory_mb"] << " MiB: " << report.blocks_refused
+              << " new blocks dropped in " << report.frames_over_budget << " frames\n";
+  }
   if (!o.mesh_path.empty()) {
     std::cerr << "mesh: " << o.mesh_path << " (" << mesh.num_vertices() << " vertices, "
               << mesh.num_triangles() << " triangles, " << j["mesh_ms"] << " ms)\n";
@@ -191,17 +200,18 @@ Command AddFuseCommand(CLI::App& app) {
   CLI::App* sub = app.add_subcommand("fuse", "Integrate an RGB-D dataset into a TSDF map");
   AddDatasetInputOptions(sub, o->in, /*with_start=*/true);
   sub->add_option("--voxel-size", o->voxel_size_m, "Voxel size in metres")
-      ->check(Positive())
+      ->check(VoxelSize())
       ->capture_default_str();
-  sub->add_option("--trunc", o->trunc_m, "Truncation distance in metres")
-      ->check(Positive())
+  sub->add_option("--trunc", o->trunc_m, "Truncation distance in metres (1 to 64 voxels)")
+      ->check(InRange(bounds::kVoxelSizeMinM * bounds::kTruncMinVoxels,
+                      bounds::kVoxelSizeMaxM * bounds::kTruncMaxVoxels, "m"))
       ->capture_default_str();
   sub->add_option("--threads", o->threads, "Worker threads (0: all hardware threads)")
-      ->check(NonNegative())
+      ->check(ThreadCount())
       ->capture_default_str();
   sub->add_option("--intrinsics", o->intrinsics, "Override intrinsics: fx,fy,cx,cy");
   sub->add_option("--depth-scale", o->depth_scale, "Override depth units per metre")
-      ->check(Positive());
+      ->check(InRange(bounds::kDepthScaleMin, bounds::kDepthScaleMax));
   sub->add_option("--weighting", o->weighting, "Observation weight")
       ->check(CLI::IsMember({"constant", "depth"}))
       ->capture_default_str();
@@ -209,10 +219,10 @@ Command AddFuseCommand(CLI::App& app) {
       ->check(CLI::IsMember({"auto", "scalar", "simd"}))
       ->capture_default_str();
   sub->add_option("--max-weight", o->max_weight, "Weight cap per voxel")
-      ->check(Positive())
+      ->check(InRange(1.0 / kWeightScale, kMaxWeight))
       ->capture_default_str();
   sub->add_option("--mesh-min-weight", o->mesh_min_weight, "Meshing: ignore voxels below this")
-      ->check(NonNegative())
+      ->check(InRange(0.0, kMaxWeight))
       ->capture_default_str();
   sub->add_option("--mesh", o->mesh_path, "Write the mesh (.ply .obj .glb .stl)")
       ->check(MeshOutputValidator());
@@ -222,7 +232,7 @@ Command AddFuseCommand(CLI::App& app) {
                 "Estimate poses by frame-to-model ICP instead of using the dataset's");
   sub->add_option("--photometric-weight", o->photometric_weight,
                   "With --track: weight of the colour term (0: geometry only)")
-      ->check(NonNegative())
+      ->check(InRange(0.0, 1000.0))
       ->capture_default_str();
   sub->add_option("--trajectory", o->trajectory_path,
                   "Write the poses used (TUM format: t tx ty tz qx qy qz qw)")
@@ -230,6 +240,7 @@ Command AddFuseCommand(CLI::App& app) {
   sub->add_option("--frame-list", o->frame_list_path,
                   "Write the integrated frames (paths, poses, intrinsics) as JSON")
       ->check(OutputFileValidator());
+  AddMemoryBudgetOptions(sub, o->memory);
   return {sub, [o] { return RunFuse(*o); }};
 }
 

@@ -71,11 +71,11 @@ Command AddMeshCommand(CLI::App& app) {
       ->required()
       ->check(MeshOutputValidator());
   sub->add_option("--min-weight", o->min_weight, "Voxels with less weight count as unobserved")
-      ->check(NonNegative())
+      ->check(InRange(0.0, kMaxWeight))
       ->capture_default_str();
   sub->add_flag("--no-color", o->no_color, "Leave vertex colours out");
   sub->add_option("--threads", o->threads, "Worker threads (0: all hardware threads)")
-      ->check(NonNegative())
+      ->check(ThreadCount())
       ->capture_default_str();
   return {sub, [o] { return RunMesh(*o); }};
 }

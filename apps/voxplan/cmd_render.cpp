@@ -8,6 +8,7 @@
 #include <tuple>
 
 #include "apps/voxplan/cli_common.h"
+#include "core/bounds.h"
 #include "core/parallel.h"
 #include "io/image_io.h"
 #include "io/map_io.h"
@@ -22,8 +23,6 @@ namespace voxplan::cli {
 namespace {
 
 namespace fs = std::filesystem;
-
-constexpr int kMaxImageSide = 8192;
 
 struct RenderOptions {
   std::string input;
@@ -50,10 +49,7 @@ Result<std::pair<int, int>> ParseSize(const std::string& text) {
   if (!(in >> width >> x >> height) || (x != 'x' && x != 'X') || (in >> extra)) {
     return InvalidArgument("--size wants WxH, e.g. 640x480: " + text);
   }
-  if (width < 1 || height < 1 || width > kMaxImageSide || height > kMaxImageSide) {
-    return InvalidArgument("--size: width and height must be 1.." + std::to_string(kMaxImageSide) +
-                           ": " + text);
-  }
+  VOXPLAN_RETURN_IF_ERROR(bounds::CheckImageSize("--size", width, height));
   return std::pair(width, height);
 }
 
@@ -196,7 +192,7 @@ Command AddRenderCommand(CLI::App& app) {
           ->check(ParsedBy(&ParsePose, "\"tx ty tz qx qy qz qw\""));
   CLI::Option* orbit =
       sub->add_option("--orbit", o->orbit, "Turntable of N views around the centre")
-          ->check(CLI::Range(1, 3600));
+          ->check(IntInRange(1, 3600));
   pose->excludes(orbit);
   sub->add_option("--mode", o->mode, "Shading")
       ->check(CLI::IsMember({"shaded", "normals", "colour", "color", "depth"}))
@@ -205,20 +201,20 @@ Command AddRenderCommand(CLI::App& app) {
       ->check(ParsedBy(&ParseSize, "WxH"))
       ->capture_default_str();
   sub->add_option("--fov-deg", o->fov_deg, "Horizontal field of view (degrees)")
-      ->check(CLI::Range(1.0, 179.0))
+      ->check(InRange(1.0, 179.0, "degrees"))
       ->capture_default_str();
   sub->add_option("--out,-o", o->out_dir, "Output folder (created if missing)")
       ->required()
       ->check(OutputDirValidator());
   sub->add_option("--min-weight", o->min_weight, "Maps: voxels with less weight are unobserved")
-      ->check(NonNegative())
+      ->check(InRange(0.0, kMaxWeight))
       ->capture_default_str();
   sub->add_option("--up", o->up, "Up axis of the scene, for orbits")
       ->check(CLI::IsMember({"y", "z"}))
       ->capture_default_str();
   sub->add_option("--orbit-radius", o->orbit_radius_m,
                   "Orbit: distance from the centre across the up axis (m; default from bounds)")
-      ->check(Positive());
+      ->check(InRange(1e-3, 1e4, "m"));
   sub->add_option_function<double>(
          "--orbit-height",
          [o](double h) {
@@ -226,15 +222,15 @@ Command AddRenderCommand(CLI::App& app) {
            o->orbit_height_set = true;
          },
          "Orbit: height above the centre along the up axis (m; default from bounds)")
-      ->check(CLI::Range(-1e6, 1e6));
+      ->check(InRange(-1e4, 1e4, "m"));
   sub->add_option("--near", o->near_m,
                   "Maps: start rays this far from the camera (m), to cut away near walls")
-      ->check(NonNegative());
+      ->check(InRange(0.0, 1e4, "m"));
   sub->add_option("--kernel", o->kernel, "Maps: ray-casting march (scalar: the reference)")
       ->check(CLI::IsMember({"auto", "scalar"}))
       ->capture_default_str();
   sub->add_option("--threads", o->threads, "Worker threads (0: all hardware threads)")
-      ->check(NonNegative())
+      ->check(ThreadCount())
       ->capture_default_str();
   return {sub, [o] { return RunRender(*o); }};
 }

@@ -8,6 +8,7 @@
 #include <memory>
 
 #include "apps/voxplan/cli_common.h"
+#include "core/bounds.h"
 #include "core/parallel.h"
 #include "io/file_util.h"
 #include "io/tum_trajectory.h"
@@ -38,7 +39,7 @@ struct SimRenderOptions {
 bool ParseSize(const std::string& text, int& w, int& h) {
   int consumed = 0;
   if (std::sscanf(text.c_str(), "%dx%d%n", &w, &h, &consumed) != 2) return false;
-  return consumed == int(text.size()) && w > 0 && h > 0 && w <= 8192 && h <= 8192;
+  return consumed == int(text.size()) && bounds::CheckImageSize("--size", w, h).ok();
 }
 
 // id, class, model of every instance: what the label images' ids mean.
@@ -53,7 +54,10 @@ int RunSimRender(const SimRenderOptions& o) {
   // Usage checks, before any work.
   int width = 0, height = 0;
   if (!ParseSize(o.size, width, height))
-    return Fail("--size wants WIDTHxHEIGHT (e.g. 640x480), got '" + o.size + "'", kExitUsage);
+    return Fail("--size wants WIDTHxHEIGHT, 1 to " + std::to_string(bounds::kImageSideMax) +
+                    " per side and at most " + std::to_string(bounds::kImagePixelsMax) +
+                    " pixels (e.g. 640x480), got '" + o.size + "'",
+                kExitUsage);
   if (o.noise != "on" && o.noise != "off")
     return Fail("--noise must be on or off, got '" + o.noise + "'", kExitUsage);
   std::error_code ec;
@@ -75,6 +79,8 @@ int RunSimRender(const SimRenderOptions& o) {
   options.camera.fy = float(o.fy != 0.0 ? o.fy : o.fx);
   options.camera.cx = float(o.cx >= 0.0 ? o.cx : 0.5 * (width - 1));
   options.camera.cy = float(o.cy >= 0.0 ? o.cy : 0.5 * (height - 1));
+  if (Status s = bounds::CheckIntrinsics(options.camera); !s.ok())
+    return Fail("--fx/--fy/--cx/--cy: " + s.message(), kExitUsage);
   options.max_range_m = float(o.max_range);
   options.noise = o.noise == "on";
   options.noise_params.seed = o.seed;
@@ -154,18 +160,22 @@ Command AddSimRenderCommand(CLI::App& sim) {
       ->required();
   AddSceneFrameOptions(sub, o->frame);
   sub->add_option("--size", o->size, "Image size WIDTHxHEIGHT")->capture_default_str();
-  sub->add_option("--fx", o->fx, "Focal length, pixels")->check(Positive())->capture_default_str();
-  sub->add_option("--fy", o->fy, "Focal length y, pixels (default: fx)");
-  sub->add_option("--cx", o->cx, "Principal point x (default: image centre)");
-  sub->add_option("--cy", o->cy, "Principal point y (default: image centre)");
+  sub->add_option("--fx", o->fx, "Focal length, pixels")
+      ->check(InRange(1e-3, 1e7))
+      ->capture_default_str();
+  sub->add_option("--fy", o->fy, "Focal length y, pixels (default: fx)")->check(InRange(-1e7, 1e7));
+  sub->add_option("--cx", o->cx, "Principal point x (default: image centre)")
+      ->check(InRange(-1e7, 1e7));
+  sub->add_option("--cy", o->cy, "Principal point y (default: image centre)")
+      ->check(InRange(-1e7, 1e7));
   sub->add_option("--noise", o->noise, "Kinect-like depth noise: on or off")->capture_default_str();
   sub->add_option("--seed", o->seed, "Noise seed (same seed, same images)")->capture_default_str();
   sub->add_option("--max-range", o->max_range, "Farthest depth returned, metres")
-      ->check(Positive())
+      ->check(InRange(0.01, bounds::kDepthMaxM, "m"))
       ->capture_default_str();
   sub->add_flag("--no-color", o->no_color, "Write no colour images");
   sub->add_flag("--no-labels", o->no_labels, "Write no label images");
-  sub->add_option("--threads", o->threads, "Worker threads (0: all)")->check(NonNegative());
+  sub->add_option("--threads", o->threads, "Worker threads (0: all)")->check(ThreadCount());
   return {sub, [o] { return RunSimRender(*o); }};
 }
 

@@ -180,7 +180,7 @@ Command AddSimSceneCommand(CLI::App& sim) {
                 "Generate parametric furniture only");
   sub->add_flag("--no-ceiling", o->no_ceiling, "Generate no ceiling");
   sub->add_option("--resolution", o->resolution, "Floor plan cell size, metres")
-      ->check(Positive())
+      ->check(InRange(0.01, 1.0, "m"))
       ->capture_default_str();
   sub->add_flag("--no-ply", o->no_ply, "Do not write <name>.ply");
   sub->add_flag("--no-glb", o->no_glb, "Do not write <name>.glb");

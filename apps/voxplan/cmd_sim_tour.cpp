@@ -1,12 +1,14 @@
 // voxplan sim tour: plan a deterministic camera tour that sees every room of a scene (floor plan,
 // viewpoint cover, ordered visits, 360° spins level, up and down at each) and write it as a TUM
 // trajectory.
+#include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <iostream>
 #include <memory>
 
 #include "apps/voxplan/cli_common.h"
+#include "core/bounds.h"
 #include "core/parallel.h"
 #include "io/tum_trajectory.h"
 #include "sim/floor_plan.h"
@@ -56,8 +58,8 @@ int RunSimTour(const SimTourOptions& o) {
     float x = 0.f, y = 0.f;
     int consumed = 0;
     if (std::sscanf(o.start.c_str(), "%f,%f%n", &x, &y, &consumed) != 2 ||
-        consumed != int(o.start.size()))
-      return Fail("--start wants x,y in metres, got '" + o.start + "'", kExitUsage);
+        consumed != int(o.start.size()) || !std::isfinite(x) || !std::isfinite(y))
+      return Fail("--start wants x,y in metres (finite), got '" + o.start + "'", kExitUsage);
     params.start_W = Eigen::Vector2f(x, y);
   }
   if (Status s = params.Validate(); !s.ok()) return Fail(s.message(), kExitUsage);
@@ -122,32 +124,34 @@ Command AddSimTourCommand(CLI::App& sim) {
   sub->add_option("--mode", o->mode, "Robot mode: explorer or reconstructor (speed, field of view)")
       ->capture_default_str();
   sub->add_option("--radius", o->radius, "Robot footprint radius, metres")
-      ->check(Positive())
+      ->check(InRange(0.01, 5.0, "m"))
       ->capture_default_str();
   sub->add_option("--camera-height", o->camera_height, "Camera height above the floor, metres")
-      ->check(Positive())
+      ->check(InRange(0.01, 10.0, "m"))
       ->capture_default_str();
   sub->add_option("--pitch", o->pitch_deg,
                   "Camera pitch while driving, degrees (positive looks up)")
+      ->check(InRange(-90.0, 90.0, "degrees"))
       ->capture_default_str();
   sub->add_option("--spin-pitches", o->spin_pitches_deg,
                   "Camera pitch of each 360° spin at a viewpoint, degrees, comma-separated")
       ->delimiter(',')
+      ->check(InRange(-90.0, 90.0, "degrees"))
       ->capture_default_str();
   sub->add_option("--view-range", o->view_range, "Range a viewpoint covers, metres")
-      ->check(Positive())
+      ->check(InRange(0.1, bounds::kDepthMaxM, "m"))
       ->capture_default_str();
   sub->add_option("--resolution", o->resolution, "Floor plan cell size, metres")
-      ->check(Positive())
+      ->check(InRange(0.01, 1.0, "m"))
       ->capture_default_str();
   sub->add_option("--frame-step", o->frame_step, "Metres of travel between frames")
-      ->check(Positive())
+      ->check(InRange(0.01, 10.0, "m"))
       ->capture_default_str();
   sub->add_option("--frame-step-deg", o->frame_step_deg, "Degrees of turning between frames")
-      ->check(Positive())
+      ->check(InRange(0.1, 360.0, "degrees"))
       ->capture_default_str();
   sub->add_option("--start", o->start, "Start position x,y in metres (default: first viewpoint)");
-  sub->add_option("--threads", o->threads, "Worker threads (0: all)")->check(NonNegative());
+  sub->add_option("--threads", o->threads, "Worker threads (0: all)")->check(ThreadCount());
   return {sub, [o] { return RunSimTour(*o); }};
 }
 

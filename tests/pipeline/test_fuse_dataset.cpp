@@ -210,3 +210,66 @@ TEST(FuseDataset, ACameraTrackingCannotUseIsRefusedNotThrown) {
 
 }  // namespace
 }  // namespace voxplan
+
+// Memory budget and entry checks (issue 29): see pipeline/fuse_dataset.h's OnMemoryLimit.
+namespace voxplan {
+namespace {
+
+const VolumeParams kTightVolume{0.005f, 0.02f, uint64_t(1) << 20};  // 256 blocks of 4 cm
+
+TEST(FuseDatasetBudget, PastTheBudgetWarnsOnceAndCountsWhatWasDropped) {
+  const RoomDataset dataset({Kind::kPosed, Kind::kPosed, Kind::kPosed});
+  std::vector<std::string> warnings;
+  FuseObserver observer;
+  observer.warning = [&](const std::string& w) { warnings.push_back(w); };
+  TsdfVolume volume(kTightVolume);
+  Result<FuseReport> r = FuseDataset(dataset, All(dataset), WholeRoom(), volume, observer);
+  ASSERT_TRUE(r.ok()) << r.status().message();
+  EXPECT_EQ(r->frames.size(), 3u);  // every frame still integrated into the blocks there are
+  EXPECT_EQ(r->frames_over_budget, 3u);
+  EXPECT_GT(r->blocks_refused, 0u);
+  EXPECT_EQ(volume.num_blocks(), 256u);
+  EXPECT_LE(volume.MemoryBytes(), kTightVolume.max_memory_bytes);
+  ASSERT_EQ(warnings.size(), 1u);
+  EXPECT_EQ(warnings[0].rfind("memory budget of 1 MiB reached at frame 0 (frame_0.png)", 0), 0u)
+      << warnings[0];
+}
+
+TEST(FuseDatasetBudget, FailModeStopsWithResourceExhausted) {
+  const RoomDataset dataset({Kind::kPosed, Kind::kPosed});
+  FuseParams params = WholeRoom();
+  params.on_memory_limit = OnMemoryLimit::kFail;
+  TsdfVolume volume(kTightVolume);
+  Result<FuseReport> r = FuseDataset(dataset, All(dataset), params, volume);
+  ASSERT_FALSE(r.ok());
+  EXPECT_EQ(r.status().code(), StatusCode::kResourceExhausted);
+  EXPECT_NE(r.status().message().find("memory budget of 1 MiB reached at frame 0"),
+            std::string::npos)
+      << r.status().message();
+}
+
+TEST(FuseDatasetBudget, InvalidParamsAreRefusedBeforeAnyFrameIsRead) {
+  // The first frame cannot be read: a refusal about it would mean the checks came too late.
+  const RoomDataset dataset({Kind::kUnreadable, Kind::kPosed});
+  TsdfVolume fine(VolumeParams{0.0001f, 0.0004f});
+  Result<FuseReport> r = FuseDataset(dataset, All(dataset), WholeRoom(), fine);
+  ASSERT_FALSE(r.ok());
+  EXPECT_NE(r.status().message().find("voxel size must be in [0.001, 1] m"), std::string::npos)
+      << r.status().message();
+  FuseParams far = WholeRoom();
+  far.integrate.max_depth_m = 1e6f;
+  TsdfVolume volume(VolumeParams{0.02f, 0.08f});
+  r = FuseDataset(dataset, All(dataset), far, volume);
+  ASSERT_FALSE(r.ok());
+  EXPECT_NE(r.status().message().find("max depth must be in [0, 100] m"), std::string::npos)
+      << r.status().message();
+  PinholeCamera wide = test::RoomCamera();
+  wide.fx = 1.f;
+  const RoomDataset wide_dataset({Kind::kUnreadable}, wide);
+  r = FuseDataset(wide_dataset, All(wide_dataset), WholeRoom(), volume);
+  ASSERT_FALSE(r.ok());
+  EXPECT_NE(r.status().message().find("|fx|"), std::string::npos) << r.status().message();
+}
+
+}  // namespace
+}  // namespace voxplan
