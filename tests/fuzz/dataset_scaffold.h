@@ -18,8 +18,9 @@ inline const std::vector<FileSpec> kTum = {
     {"rgb.txt", "1.000000 c.png\n1.033333 c.png\n"},
     {"groundtruth.txt", "0.9 0 0 0 0 0 0 1\n1.1 0.1 0 0 0 0 0 1\n"},
     {"camera.txt", "20 20 1.5 1\n"}};
-inline const std::vector<FileSpec> kIcl = {{"associations.txt", "0 d.png 0 c.png\n1 d.png 1 c.png\n"},
-                                    {"traj0.gt.freiburg", "0 0 0 0 0 0 0 1\n1 0 0 0.1 0 0 0 1\n"}};
+inline const std::vector<FileSpec> kIcl = {
+    {"associations.txt", "0 d.png 0 c.png\n1 d.png 1 c.png\n"},
+    {"traj0.gt.freiburg", "0 0 0 0 0 0 0 1\n1 0 0 0.1 0 0 0 1\n"}};
 inline const std::vector<FileSpec> kRedwood = {
     {"camera.json", R"({"width": 4, "height": 3, "intrinsic_matrix": [20,0,0,0,20,0,1.5,1,1]})"},
     {"trajectory.log",

@@ -38,8 +38,8 @@ void CheckRaycast(const TsdfVolume& volume) {
   if (volume.num_blocks() == 0) return;
   Eigen::Vector3f lo = Eigen::Vector3f::Constant(1e30f), hi = -lo;
   volume.ForEachBlock([&](BlockIndex b, const TsdfBlock&) {
-    const Eigen::Vector3f corner = Eigen::Vector3f(float(b.x), float(b.y), float(b.z)) *
-                                   volume.block_size_m();
+    const Eigen::Vector3f corner =
+        Eigen::Vector3f(float(b.x), float(b.y), float(b.z)) * volume.block_size_m();
     lo = lo.cwiseMin(corner);
     hi = hi.cwiseMax(corner + Eigen::Vector3f::Constant(volume.block_size_m()));
   });

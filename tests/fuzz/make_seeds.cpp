@@ -149,7 +149,8 @@ void SharedData(const fs::path& out, const fs::path& data) {
   excerpt("fuzz_dataset", "redwood_match", 8, redwood / "rgbd.match", 5);
   const fs::path seven = rgbd / "7scenes_redkitchen";
   excerpt("fuzz_dataset", "7scenes_intrinsics", 9, seven / "camera-intrinsics.txt", 5);
-  excerpt("fuzz_dataset", "3dmatch_intrinsics", 9, rgbd / "3dmatch_sun3d5/camera-intrinsics.txt", 5);
+  excerpt("fuzz_dataset", "3dmatch_intrinsics", 9, rgbd / "3dmatch_sun3d5/camera-intrinsics.txt",
+          5);
   excerpt("fuzz_dataset", "7scenes_pose", 10, seven / "frame-000000.pose.txt", 5);
   const fs::path replica = rgbd / "replica_office0";
   excerpt("fuzz_dataset", "replica_params", 11, replica / "cam_params.json", 40);
@@ -160,9 +161,12 @@ void SharedData(const fs::path& out, const fs::path& data) {
     if (!fs::is_regular_file(source, ec)) return;
     Put(out / target, name, pre + ReadAll(source).substr(0, bytes));
   };
-  head("fuzz_mesh", "table.ply", std::string(1, '\0'), data / "scenes/simple_room/receptacle_mesh_simple_room_table.ply", 8192);
-  head("fuzz_mesh", "cornell.obj", std::string(1, '\1'), data / "scenes/cornell_box/CornellBox-Original.obj", 8192);
-  head("fuzz_mesh", "room.glb", std::string(1, '\2'), data / "scenes/simple_room/simple_room.glb", 12000);
+  head("fuzz_mesh", "table.ply", std::string(1, '\0'),
+       data / "scenes/simple_room/receptacle_mesh_simple_room_table.ply", 8192);
+  head("fuzz_mesh", "cornell.obj", std::string(1, '\1'),
+       data / "scenes/cornell_box/CornellBox-Original.obj", 8192);
+  head("fuzz_mesh", "room.glb", std::string(1, '\2'), data / "scenes/simple_room/simple_room.glb",
+       12000);
   head("fuzz_image", "seven.jpg", "", seven / "frame-000000.color.jpg", 12000);
 
   // Depth images cropped to 16x12, as 16-bit PNGs the library writes.
