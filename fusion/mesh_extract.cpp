@@ -278,7 +278,9 @@ Mesh Assemble(const std::vector<const BlockMesh*>& parts, const MeshParams& para
   std::vector<uint8_t> any_degenerate(num_parts, 0);
   ParallelFor(num_parts, kPartsPerTask, [&](size_t begin, size_t end) {
     for (size_t i = begin; i < end; ++i) {
-      std::array<uint32_t, 3>* out = &mesh.triangles[triangle_offset[i]];
+      // data() + offset, not &triangles[offset]: a part without triangles may sit at the end
+      // (offset == size, or an empty vector), where operator[] is undefined.
+      std::array<uint32_t, 3>* out = mesh.triangles.data() + triangle_offset[i];
       for (const auto& tri : parts[i]->triangles) {
         *out = {welded[offset[i] + tri[0]], welded[offset[i] + tri[1]], welded[offset[i] + tri[2]]};
         any_degenerate[i] |= uint8_t(degenerate(*out++));

@@ -95,6 +95,23 @@ TEST(MarchingCubes, UnobservedVoxelsProduceNothing) {
   EXPECT_EQ(ExtractMesh(volume, params).num_triangles(), 0u);
 }
 
+// Observed free space only: every block is meshed and yields no triangle. Found by fuzz_map (a
+// loaded map of such blocks); under UBSan (build-asan) assembling it bound a reference to the
+// empty triangle array.
+TEST(MarchingCubes, ObservedFreeSpaceGivesAnEmptyMesh) {
+  TsdfVolume volume({0.05f, 0.2f});
+  for (int x = 0; x < 3; ++x) {
+    TsdfBlock& block = volume.FindOrAllocate({x, 0, 0});
+    for (int i = 0; i < kBlockVoxels; ++i) {
+      block.tsdf[i] = EncodeTsdf(1.f);
+      block.weight[i] = EncodeWeight(4.f);
+    }
+  }
+  const Mesh mesh = ExtractMesh(volume);
+  EXPECT_TRUE(mesh.triangles.empty());
+  EXPECT_TRUE(mesh.positions.empty());
+}
+
 }  // namespace
 }  // namespace voxplan
 
