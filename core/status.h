@@ -15,7 +15,8 @@ enum class StatusCode {
   kIoError,
   kCorruptData,
   kUnsupported,
-  kInternal
+  kInternal,
+  kCancelled  // the caller asked the work to stop (e.g. the CLI got SIGINT)
 };
 
 class [[nodiscard]] Status {
@@ -48,6 +49,7 @@ inline Status NotFound(std::string m) { return {StatusCode::kNotFound, std::move
 inline Status IoError(std::string m) { return {StatusCode::kIoError, std::move(m)}; }
 inline Status CorruptData(std::string m) { return {StatusCode::kCorruptData, std::move(m)}; }
 inline Status Unsupported(std::string m) { return {StatusCode::kUnsupported, std::move(m)}; }
+inline Status Cancelled(std::string m) { return {StatusCode::kCancelled, std::move(m)}; }
 
 template <typename T>
 class [[nodiscard]] Result {

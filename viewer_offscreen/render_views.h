@@ -2,6 +2,7 @@
 // Shaded views of a SurfaceScene: one from a given pose or a turntable framed on its bounds,
 // all kept in memory so a caller writes files only once every view has rendered.
 #include <Eigen/Geometry>
+#include <functional>
 #include <optional>
 #include <vector>
 
@@ -26,6 +27,8 @@ struct RenderViewsParams {
   std::optional<float> orbit_radius_m;  // across the up axis; unset: framed on the bounds
   std::optional<float> orbit_height_m;  // along the up axis; unset: framed on the bounds
   float orbit_elevation_deg = 35.0f;    // of the framing
+  // Polled before every view: true ends the rendering there with a kCancelled status.
+  std::function<bool()> stop_requested;
 };
 
 struct RenderedViews {
@@ -36,7 +39,7 @@ struct RenderedViews {
   double hit_fraction = 0.0;  // mean over the views of the share of pixels on a surface
 };
 
-// Renders and shades every view; fails only when shading refuses an image.
+// Renders and shades every view; fails only when shading refuses an image or on a stop request.
 Result<RenderedViews> RenderViews(const SurfaceScene& scene, const RenderViewsParams& params);
 
 }  // namespace voxplan
