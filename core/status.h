@@ -16,7 +16,8 @@ enum class StatusCode {
   kCorruptData,
   kUnsupported,
   kResourceExhausted,  // a budget (memory) was reached
-  kInternal
+  kInternal,
+  kCancelled  // the caller asked the work to stop (e.g. the CLI got SIGINT)
 };
 
 class [[nodiscard]] Status {
@@ -52,6 +53,7 @@ inline Status Unsupported(std::string m) { return {StatusCode::kUnsupported, std
 inline Status ResourceExhausted(std::string m) {
   return {StatusCode::kResourceExhausted, std::move(m)};
 }
+inline Status Cancelled(std::string m) { return {StatusCode::kCancelled, std::move(m)}; }
 
 template <typename T>
 class [[nodiscard]] Result {

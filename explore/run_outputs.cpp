@@ -188,4 +188,12 @@ Status WriteRunOutputs(const ExploreRunParams& params, const ExploreRunReport& r
   return WriteTopDown(r, InFolder(params.out_dir, "topdown.png"));
 }
 
+std::vector<std::string> RunOutputFiles(const std::string& out_dir) {
+  std::vector<std::string> paths;
+  for (const char* name : {"mesh.ply", "metrics.json", "run_log.csv", "timeseries.csv",
+                           "plan_log.txt", "plan_calls.csv", "topdown.png"})
+    paths.push_back(InFolder(out_dir, name));
+  return paths;
+}
+
 }  // namespace voxplan

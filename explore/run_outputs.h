@@ -12,6 +12,7 @@
 // Every error names the file it could not write. The report as JSON is here too, beside
 // metrics.json.
 #include <string>
+#include <vector>
 
 #include "core/mesh.h"
 #include "core/status.h"
@@ -30,5 +31,8 @@ std::string RunSummaryJson(const ExploreRunParams& params, const ExploreRunRepor
 
 // Everything but mesh.ply into params.out_dir.
 Status WriteRunOutputs(const ExploreRunParams& params, const ExploreRunReport& report);
+
+// The paths of every file above in `out_dir`, for a caller to check against its inputs.
+std::vector<std::string> RunOutputFiles(const std::string& out_dir);
 
 }  // namespace voxplan

@@ -90,6 +90,7 @@ class ListDataset final : public Dataset {
       : info_(std::move(info)), entries_(std::move(entries)) {}
 
   const DatasetInfo& info() const override { return info_; }
+  std::vector<std::string> InputFiles() const override;
 
   Result<Frame> Load(size_t i) const override {
     if (i >= entries_.size())
@@ -127,6 +128,33 @@ class ListDataset final : public Dataset {
   DatasetInfo info_;
   std::vector<Entry> entries_;
 };
+
+// Association lists, trajectories and camera files sit at the top of the folder; voxplan's own
+// outputs (meshes, maps, images) may sit there too without being read.
+bool IsTopLevelInput(const fs::path& file) {
+  static const char* const kNotRead[] = {".ply", ".obj",   ".glb", ".gltf", ".stl",
+                                         ".dae", ".vpmap", ".png", ".jpg",  ".jpeg"};
+  std::string ext = file.extension().string();
+  std::transform(ext.begin(), ext.end(), ext.begin(),
+                 [](unsigned char c) { return std::tolower(c); });
+  return std::none_of(std::begin(kNotRead), std::end(kNotRead),
+                      [&](const char* e) { return ext == e; });
+}
+
+std::vector<std::string> ListDataset::InputFiles() const {
+  std::vector<std::string> files;
+  for (const Entry& e : entries_) {
+    files.push_back(e.depth_path);
+    if (!e.color_path.empty()) files.push_back(e.color_path);
+  }
+  std::error_code ec;
+  for (const std::string& f : {info_.pose_source, info_.intrinsics_source})
+    if (fs::is_regular_file(f, ec)) files.push_back(f);
+  for (fs::directory_iterator it(info_.root, ec), end; !ec && it != end; it.increment(ec))
+    if (it->is_regular_file(ec) && IsTopLevelInput(it->path()))
+      files.push_back(it->path().string());
+  return files;
+}
 
 Result<std::unique_ptr<Dataset>> Finish(Draft d, const DatasetOptions& options) {
   if (d.entries.empty())

@@ -53,6 +53,10 @@ class Dataset {
   virtual const DatasetInfo& info() const = 0;
   // Loads frame i (0 <= i < num_frames): decodes depth (and colour), checks sizes and bit depth.
   virtual Result<Frame> Load(size_t i) const = 0;
+  // Every file it reads: each frame's images, the pose and intrinsics files and the lists at
+  // the top of its folder (every file there but meshes, maps and images), so that a command can
+  // refuse an output that would overwrite one. Empty for datasets without files.
+  virtual std::vector<std::string> InputFiles() const { return {}; }
 };
 
 Result<std::unique_ptr<Dataset>> OpenDataset(const std::string& path,

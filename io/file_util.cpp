@@ -10,6 +10,9 @@
 #include <fstream>
 #include <system_error>
 
+#include "io/output_transaction.h"
+#include "io/temp_files.h"
+
 namespace voxplan {
 
 namespace fs = std::filesystem;
@@ -31,23 +34,31 @@ Status WriteAtomically(const std::string& path,
                        const std::function<Status(const std::string&)>& write) {
   if (path.empty()) return InvalidArgument("cannot write to an empty path");
   const std::string tmp = TempPathFor(path);
+  // Remembered before it exists, so a signal at any point removes it.
+  const int slot = RememberTempFile(tmp);
+  if (slot < 0) return IoError("writing " + path + ": too many temporary files in flight");
   std::error_code ec;
+  const auto discard = [&] {
+    fs::remove(tmp, ec);
+    ForgetTempFile(slot);
+  };
   const Status written = write(tmp);
   if (!written.ok()) {
-    fs::remove(tmp, ec);
+    discard();
     return written.WithContext("writing " + path);
   }
   if (!fs::is_regular_file(tmp, ec)) {
-    fs::remove(tmp, ec);
+    discard();
     return IoError("writing " + path + ": the writer produced no file");
   }
+  if (OutputTransaction::StageInOpenTransaction(tmp, slot, path)) return Status::Ok();
   fs::rename(tmp, path, ec);
   if (ec) {
-    std::error_code ignored;
-    fs::remove(tmp, ignored);
-    return IoError("writing " + path +
-                   ": cannot rename the temporary file into place: " + ec.message());
+    const std::string why = ec.message();
+    discard();
+    return IoError("writing " + path + ": cannot rename the temporary file into place: " + why);
   }
+  ForgetTempFile(slot);
   return Status::Ok();
 }
 

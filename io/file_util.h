@@ -10,6 +10,9 @@ namespace voxplan {
 
 // Calls write(tmp_path) with a temporary path in the target's folder (same extension), then
 // renames it over `path`. On any failure the temporary file is removed and `path` is untouched.
+// While an OutputTransaction (io/output_transaction.h) is open, the finished temporary file is
+// handed to it instead and renamed at its Commit. The temporary file is named
+// `<path>.tmp-<pid>-<n><extension>` and listed in io/temp_files.h until renamed or removed.
 Status WriteAtomically(const std::string& path,
                        const std::function<Status(const std::string&)>& write);
 

@@ -97,6 +97,9 @@ Result<FuseReport> FuseDataset(const Dataset& dataset, const std::vector<size_t>
   const Stopwatch loop_clock;
   for (size_t k = 0; k < indices.size(); ++k) {
     const size_t i = indices[k];
+    if (observer.stop_requested && observer.stop_requested())
+      return Cancelled("stopped before frame " + std::to_string(i) + " (" + std::to_string(k) +
+                       " of " + std::to_string(indices.size()) + " selected frames done)");
     const Stopwatch load_clock;
     Result<Frame> frame = dataset.Load(i);
     const double load_ms = load_clock.ElapsedMs();

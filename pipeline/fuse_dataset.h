@@ -63,6 +63,9 @@ struct FuseObserver {
   // After each integrated frame, outside the integration timing (e.g. an incremental mesher);
   // a failure stops the run with that status.
   std::function<Status(const Frame& frame, const Pose3f& T_W_C, TsdfVolume& volume)> integrated;
+  // Polled before every selected frame: true ends the run there with a kCancelled status (the
+  // frame in progress is finished first). The CLI sets it from SIGINT / SIGTERM.
+  std::function<bool()> stop_requested;
 };
 
 // Fuses dataset frames `indices` (in that order) into `volume`. Fails, naming the frame and its

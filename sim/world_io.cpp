@@ -183,6 +183,20 @@ Status WriteFloorPlanYaml(const FloorPlan& plan, const FloorPlanParams& params,
   return WriteFileAtomically(path, out);
 }
 
+std::vector<std::string> WorldFilePaths(const std::string& out_dir,
+                                        const WorldWriteOptions& options) {
+  std::vector<std::string> suffixes;
+  if (options.write_ply) suffixes.push_back(".ply");
+  if (options.write_glb) suffixes.push_back(".glb");
+  suffixes.insert(suffixes.end(), {"_instances.tsv", "_rooms.tsv"});
+  if (options.write_floor_plan)
+    suffixes.insert(suffixes.end(), {"_floor_plan.png", "_floor_plan.yaml"});
+  std::vector<std::string> paths;
+  for (const std::string& s : suffixes)
+    paths.push_back((fs::path(out_dir) / (options.basename + s)).string());
+  return paths;
+}
+
 Result<WrittenWorld> WriteWorld(const World& world_in, const std::string& out_dir,
                                 const WorldWriteOptions& options) {
   std::error_code ec;

@@ -39,6 +39,10 @@ struct WrittenWorld {
 // unique and listed in `instances`).
 Result<WrittenWorld> WriteWorld(const World& world, const std::string& out_dir,
                                 const WorldWriteOptions& options = {});
+// Every file WriteWorld may write with these options (the room table even when there are no
+// rooms), known before the world exists: what a caller checks against its inputs.
+std::vector<std::string> WorldFilePaths(const std::string& out_dir,
+                                        const WorldWriteOptions& options = {});
 
 // The world with its triangles reordered as WriteWorld stores them (grouped by instance in the
 // order of world.instances, kNoInstance last; order kept within a group); vertices untouched.

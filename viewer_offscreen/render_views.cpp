@@ -51,6 +51,9 @@ Result<RenderedViews> RenderViews(const SurfaceScene& scene, const RenderViewsPa
 
   double hit_fraction_sum = 0.0;
   for (const Pose3f& T_W_C : views.T_W_C) {
+    if (params.stop_requested && params.stop_requested())
+      return Cancelled("stopped after " + std::to_string(views.images.size()) + " of " +
+                       std::to_string(views.T_W_C.size()) + " views");
     const SurfaceImages surface = scene.Render(camera, T_W_C);
     const size_t hits = size_t(std::count_if(surface.depth.data.begin(), surface.depth.data.end(),
                                              [](float z) { return z > 0.0f; }));

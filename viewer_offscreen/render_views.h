@@ -2,6 +2,7 @@
 // Shaded views of a SurfaceScene: one from a given pose or a turntable framed on its bounds,
 // all kept in memory so a caller writes files only once every view has rendered.
 #include <Eigen/Geometry>
+#include <functional>
 #include <optional>
 #include <vector>
 
@@ -30,6 +31,8 @@ struct RenderViewsParams {
   // Image size within core/bounds.h's, field of view in [1, 179] degrees, 1 to 3600 orbit
   // views, finite orbit numbers and pose; InvalidArgument naming the value otherwise.
   Status Validate() const;
+  // Polled before every view: true ends the rendering there with a kCancelled status.
+  std::function<bool()> stop_requested;
 };
 
 struct RenderedViews {
@@ -40,7 +43,8 @@ struct RenderedViews {
   double hit_fraction = 0.0;  // mean over the views of the share of pixels on a surface
 };
 
-// Renders and shades every view; fails when the params are invalid or shading refuses an image.
+// Renders and shades every view; fails when the params are invalid, when shading refuses an
+// image or on a stop request.
 Result<RenderedViews> RenderViews(const SurfaceScene& scene, const RenderViewsParams& params);
 
 }  // namespace voxplan

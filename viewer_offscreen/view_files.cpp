@@ -11,13 +11,19 @@ namespace {
 namespace fs = std::filesystem;
 
 // Removes what this run wrote, so a failed run leaves nothing behind.
-void CleanUp(const std::vector<std::string>& written, const fs::path& created_dir) {
+void CleanUp(const std::vector<std::string>& added, const fs::path& created_dir) {
   std::error_code ec;
-  for (const std::string& path : written) fs::remove(path, ec);
+  for (const std::string& path : added) fs::remove(path, ec);
   if (!created_dir.empty()) fs::remove_all(created_dir, ec);
 }
 
 }  // namespace
+
+std::string ViewFileName(size_t k) {
+  char name[32];
+  std::snprintf(name, sizeof(name), "render_%03zu.png", k);
+  return name;
+}
 
 Result<std::vector<std::string>> WriteViewFiles(const std::string& out_dir,
                                                 const std::vector<ColorImage>& images,
@@ -36,16 +42,16 @@ Result<std::vector<std::string>> WriteViewFiles(const std::string& out_dir,
     }
     created_dir = top;
   }
-  std::vector<std::string> written;
+  std::vector<std::string> written, added;  // added: written where no file was before
   for (size_t k = 0; k < images.size(); ++k) {
-    char name[32];
-    std::snprintf(name, sizeof(name), "render_%03zu.png", k);
-    const std::string path = (dir / name).string();
+    const std::string path = (dir / ViewFileName(k)).string();
+    const bool existed = fs::exists(path, ec);
     if (Status s = write_png(path, images[k]); !s.ok()) {
-      CleanUp(written, created_dir);
+      CleanUp(added, created_dir);
       return s.Naming(path);
     }
     written.push_back(path);
+    if (!existed) added.push_back(path);
   }
   return written;
 }

@@ -9,6 +9,7 @@
 
 #include "apps/voxplan/cli_common.h"
 #include "apps/voxplan/cmd_bench_report.h"
+#include "apps/voxplan/path_check.h"
 #include "bench/harness/fusion_bench.h"
 #include "bench/harness/open3d_runner.h"
 #include "core/bounds.h"
@@ -73,6 +74,10 @@ int RunBench(const BenchOptions& o, BenchMode mode) {
 
   OpenedDataset opened;
   if (int code = OpenDatasetInput(o.in, {}, &opened); code != kExitOk) return code;
+  std::vector<PathUse> inputs;
+  AddInputs(inputs, "the dataset", opened.dataset->InputFiles());
+  if (int code = RefusePathCollisions({{"--json", o.json_path}}, inputs); code != kExitOk)
+    return code;
   const Dataset& dataset = *opened.dataset;
   const DatasetInfo& info = dataset.info();
   const std::vector<size_t>& indices = opened.indices;

@@ -6,6 +6,7 @@
 #include <memory>
 
 #include "apps/voxplan/cli_common.h"
+#include "apps/voxplan/path_check.h"
 #include "bench/harness/maps_bench.h"
 #include "core/bounds.h"
 #include "io/dataset.h"
@@ -31,6 +32,12 @@ struct MapsOptions {
 int RunBenchMaps(const MapsOptions& o) {
   OpenedDataset opened;
   if (int code = OpenDatasetInput(o.in, {}, &opened); code != kExitOk) return code;
+  std::vector<PathUse> inputs;
+  AddInputs(inputs, "the dataset", opened.dataset->InputFiles());
+  if (int code =
+          RefusePathCollisions({{"--json", o.json_path}, {"--export-bt", o.bt_path}}, inputs);
+      code != kExitOk)
+    return code;
   const DatasetInfo& info = opened.dataset->info();
 
   bench::MapsBenchParams params;

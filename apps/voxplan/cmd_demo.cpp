@@ -6,6 +6,7 @@
 #include <memory>
 
 #include "apps/voxplan/cli_common.h"
+#include "apps/voxplan/signals.h"
 #include "core/parallel.h"
 #include "eval/eval_mesh.h"
 #include "eval/visibility.h"
@@ -59,6 +60,8 @@ Result<MeshEvalResult> ScoreDemoMesh(const Mesh& mesh, const Mesh& room,
 
 int RunDemo(const DemoOptions& o) {
   std::error_code ec;
+  OutputTransaction transaction;  // every file lands, or none (and no folder it made)
+  transaction.WatchFolder(o.out_dir);
   fs::create_directories(o.out_dir, ec);
   if (!fs::is_directory(o.out_dir, ec)) return Fail("cannot create output folder: " + o.out_dir);
   const fs::path dir(o.out_dir);
@@ -97,8 +100,12 @@ int RunDemo(const DemoOptions& o) {
   FuseObserver observer;
   observer.progress = [&](size_t done, size_t) { progress.Update(done); };
   observer.warning = [&](const std::string& message) { progress.Warn(message); };
+  const StopPolling polling;  // a signal ends the loop after the current frame
+  observer.stop_requested = StopRequestedFn();
   Result<FuseReport> report = FuseDataset(frames, indices, fuse, volume, observer);
   progress.Finish();
+  if (!report.ok() && report.status().code() == StatusCode::kCancelled)
+    return Interrupted(report.status().message() + "; nothing written");
   if (!report.ok()) return Fail(report.status().message());
 
   const Stopwatch mesh_clock;
@@ -159,6 +166,7 @@ int RunDemo(const DemoOptions& o) {
   j["stats"] = stats_path;
   j["peak_rss_mb"] = PeakRssMb();
   if (Status s = WriteJsonFile(j, stats_path); !s.ok()) return Fail(MessageNaming(s, stats_path));
+  if (int code = CommitOutputs(transaction); code != kExitOk) return code;
 
   std::cerr << "integrated " << poses.size() << " frames: integrate median "
             << j["integrate_ms_median"] << " ms, render median " << j["render_ms_median"] << " ms; "

@@ -4,6 +4,7 @@
 #include <memory>
 
 #include "apps/voxplan/cli_common.h"
+#include "apps/voxplan/path_check.h"
 #include "eval/eval_run.h"
 #include "sim/floor_plan.h"
 
@@ -24,6 +25,11 @@ struct EvalRunOptions {
 int RunEvalRun(const EvalRunOptions& o) {
   std::error_code ec;
   if (!fs::is_regular_file(o.run_log, ec)) return Fail("run log not found: " + o.run_log);
+  if (int code = RefusePathCollisions({{"--csv", o.csv}}, {{"the run log", o.run_log},
+                                                           {"--scene", o.scene.scene},
+                                                           {"--instances", o.scene.instances}});
+      code != kExitOk)
+    return code;
   Result<std::vector<RobotTrack>> tracks = ReadRunLog(o.run_log);
   if (!tracks.ok()) return Fail(MessageNaming(tracks.status(), o.run_log));
 

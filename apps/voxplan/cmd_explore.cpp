@@ -9,6 +9,8 @@
 #include <sstream>
 
 #include "apps/voxplan/cli_common.h"
+#include "apps/voxplan/path_check.h"
+#include "apps/voxplan/signals.h"
 #include "core/parallel.h"
 #include "explore/explore_run.h"
 #include "explore/run_outputs.h"
@@ -137,6 +139,14 @@ ExploreRunParams RunParams(const ExploreOptions& o, std::vector<Eigen::Vector2f>
 int RunExploreCommand(const ExploreOptions& o) {
   std::vector<Eigen::Vector2f> starts;
   if (int code = CheckUsage(o, &starts); code != kExitOk) return code;
+  std::vector<PathUse> outputs;
+  for (const std::string& path : RunOutputFiles(o.run.out_dir)) outputs.push_back({"--out", path});
+  const bool planner_file = o.planner.find('/') != std::string::npos;
+  if (int code = RefusePathCollisions(outputs, {{"--scene", o.run.scene},
+                                                {"--planner", planner_file ? o.planner : ""},
+                                                {"--planner-config", o.planner_config}});
+      code != kExitOk)
+    return code;
   std::unique_ptr<LoadedPlanner> planner;
   if (int code = LoadPlannerOption(o, &planner); code != kExitOk) return code;
 
@@ -156,8 +166,11 @@ int RunExploreCommand(const ExploreOptions& o) {
   };
   const ExploreRunParams run = RunParams(o, std::move(starts));
   bool refused = false;
+  OutputTransaction transaction;  // every file lands, or none (and no folder it made)
+  transaction.WatchFolder(run.out_dir);
   Result<ExploreRunReport> report = RunExploreExperiment(run, *planner, observer, &refused);
   if (!report.ok()) return Fail(report.status().message(), refused ? kExitUsage : kExitFailure);
+  if (int code = CommitOutputs(transaction); code != kExitOk) return code;
   const ExploreResult& r = report->loop;
   for (const std::string& w : report->warnings) Warn(w);
   json j = json::parse(RunSummaryJson(run, *report));

@@ -9,6 +9,8 @@
 
 #include "apps/voxplan/cli_common.h"
 #include "core/bounds.h"
+#include "apps/voxplan/path_check.h"
+#include "apps/voxplan/signals.h"
 #include "core/parallel.h"
 #include "core/volume.h"
 #include "fusion/integrate.h"
@@ -103,6 +105,18 @@ nlohmann::json FuseStats(const FuseOptions& o, const DatasetInfo& info,
   return j;
 }
 
+// No output may be another output or one of the dataset's files.
+int RefuseCollisions(const FuseOptions& o, const Dataset& dataset) {
+  std::vector<PathUse> inputs;
+  AddInputs(inputs, "the dataset", dataset.InputFiles());
+  return RefusePathCollisions({{"--mesh", o.mesh_path},
+                               {"--map", o.map_path},
+                               {"--stats", o.stats_path},
+                               {"--trajectory", o.trajectory_path},
+                               {"--frame-list", o.frame_list_path}},
+                              inputs);
+}
+
 int RunFuse(const FuseOptions& o) {
   // Everything the arguments alone can refuse is refused before the dataset is read.
   if (std::string why = CheckVoxelAndTrunc(o.voxel_size_m, o.trunc_m); !why.empty())
@@ -121,6 +135,7 @@ int RunFuse(const FuseOptions& o) {
   const Dataset& dataset = *opened.dataset;
   const DatasetInfo& info = dataset.info();
   const std::vector<size_t>& indices = opened.indices;
+  if (int code = RefuseCollisions(o, dataset); code != kExitOk) return code;
 
   IntegrateParams params;
   params.min_depth_m = float(o.in.min_depth_m);
@@ -148,8 +163,12 @@ int RunFuse(const FuseOptions& o) {
   FuseObserver observer;
   observer.progress = [&](size_t done, size_t) { progress.Update(done); };
   observer.warning = [&](const std::string& message) { progress.Warn(message); };
+  const StopPolling polling;  // a signal ends the loop after the current frame
+  observer.stop_requested = StopRequestedFn();
   Result<FuseReport> fused = FuseDataset(dataset, indices, fuse, volume, observer);
   progress.Finish();
+  if (!fused.ok() && fused.status().code() == StatusCode::kCancelled)
+    return Interrupted(fused.status().message() + "; nothing written");
   if (!fused.ok()) return Fail(fused.status().message());
   const FuseReport& report = *fused;
   if (report.frames.empty()) {
@@ -161,6 +180,7 @@ int RunFuse(const FuseOptions& o) {
   mesh_params.min_weight = float(o.mesh_min_weight);
   const FrameListParams list{info.camera, info.depth_scale, o.voxel_size_m,
                              o.trunc_m,   o.in.min_depth_m, o.in.max_depth_m};
+  OutputTransaction written;  // every output lands, or none
   Result<FuseOutputs> outputs =
       WriteFuseOutputs({o.mesh_path, o.map_path, o.trajectory_path, o.frame_list_path}, volume,
                        report, mesh_params, list);
@@ -173,6 +193,7 @@ int RunFuse(const FuseOptions& o) {
       return Fail(MessageNaming(s, o.stats_path));
     }
   }
+  if (int code = CommitOutputs(written); code != kExitOk) return code;
 
   std::cerr << "fused " << integrated << " frames (" << j["frames_skipped"] << " skipped) in "
             << j["loop_s"] << " s: integrate median " << j["integrate_ms_median"]

@@ -4,6 +4,7 @@
 #include <memory>
 
 #include "apps/voxplan/cli_common.h"
+#include "apps/voxplan/path_check.h"
 #include "core/parallel.h"
 #include "fusion/mesh_extract.h"
 #include "io/map_io.h"
@@ -26,6 +27,9 @@ int RunMesh(const MeshOptions& o) {
   if (!std::filesystem::is_regular_file(o.map_path, ec)) {
     return Fail("map file not found: " + o.map_path);
   }
+  if (int code = RefusePathCollisions({{"--out", o.out_path}}, {{"the map", o.map_path}});
+      code != kExitOk)
+    return code;
   ThreadLimit thread_limit(o.threads);
   const Stopwatch load_clock;
   Result<TsdfVolume> volume = LoadMap(o.map_path);

@@ -9,6 +9,8 @@
 
 #include "apps/voxplan/cli_common.h"
 #include "core/bounds.h"
+#include "apps/voxplan/path_check.h"
+#include "apps/voxplan/signals.h"
 #include "core/parallel.h"
 #include "io/image_io.h"
 #include "io/map_io.h"
@@ -84,6 +86,12 @@ int RunRender(const RenderOptions& o) {
   params.up_W = o.up == "y" ? Eigen::Vector3f::UnitY() : Eigen::Vector3f(Eigen::Vector3f::UnitZ());
   if (!o.pose.empty()) params.T_W_C = *ParsePose(o.pose);  // checked by the validator
   params.orbit_views = o.orbit;
+  // The files it will write: none may be the input.
+  std::vector<PathUse> outputs;
+  for (int k = 0; k < (params.T_W_C ? 1 : std::max(o.orbit, 1)); ++k)
+    outputs.push_back({"--out", (fs::path(o.out_dir) / ViewFileName(size_t(k))).string()});
+  if (int code = RefusePathCollisions(outputs, {{"the input", o.input}}); code != kExitOk)
+    return code;
   ThreadLimit thread_limit(o.threads);
 
   const Stopwatch load_clock;
@@ -96,15 +104,22 @@ int RunRender(const RenderOptions& o) {
   const double load_ms = load_clock.ElapsedMs();
 
   const Stopwatch render_clock;
+  const StopPolling polling;  // a signal ends the rendering after the current view
+  params.stop_requested = StopRequestedFn();
   Result<RenderedViews> views = RenderViews(**loaded, params);
+  if (!views.ok() && views.status().code() == StatusCode::kCancelled)
+    return Interrupted(views.status().message() + "; nothing written");
   if (!views.ok()) return Fail("shading failed: " + views.status().message());
   const double render_ms = render_clock.ElapsedMs();
 
   // Only now touch the disk: every image is in memory.
   const Stopwatch write_clock;
+  OutputTransaction transaction;  // every view lands, or none
+  transaction.WatchFolder(o.out_dir);
   Result<std::vector<std::string>> written =
       WriteViewFiles(o.out_dir, views->images, WriteColorPng);
   if (!written.ok()) return Fail(written.status().message());
+  if (int code = CommitOutputs(transaction); code != kExitOk) return code;
   const double write_ms = write_clock.ElapsedMs();
 
   for (const std::string& path : *written) std::cerr << "wrote " << path << "\n";

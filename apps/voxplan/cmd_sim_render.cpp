@@ -9,6 +9,7 @@
 
 #include "apps/voxplan/cli_common.h"
 #include "core/bounds.h"
+#include "apps/voxplan/path_check.h"
 #include "core/parallel.h"
 #include "io/file_util.h"
 #include "io/tum_trajectory.h"
@@ -72,6 +73,14 @@ int RunSimRender(const SimRenderOptions& o) {
     if (!fs::is_directory(parent, ec))
       return Fail("output folder's parent does not exist: " + parent.string(), kExitUsage);
   }
+  std::vector<PathUse> outputs;
+  for (const char* name :
+       {"groundtruth.txt", "camera.txt", "depth.txt", "rgb.txt", "labels.txt", "instances.tsv"})
+    outputs.push_back({"--out", (out / name).string()});
+  if (int code =
+          RefusePathCollisions(outputs, {{"--scene", o.scene}, {"--trajectory", o.trajectory}});
+      code != kExitOk)
+    return code;
   SimDatasetOptions options;
   options.camera.width = width;
   options.camera.height = height;

@@ -6,6 +6,8 @@
 #include <memory>
 
 #include "apps/voxplan/cli_common.h"
+#include "apps/voxplan/path_check.h"
+#include "apps/voxplan/signals.h"
 #include "sim/apartment.h"
 #include "sim/floor_plan.h"
 #include "sim/scene_loader.h"
@@ -68,6 +70,18 @@ int RunSimScene(const SimSceneOptions& o) {
   }
   if (!o.scene.empty() && !fs::is_regular_file(o.scene, ec))
     return Fail("scene file not found: " + o.scene);
+  WorldWriteOptions write;
+  write.basename = o.name;
+  write.write_ply = !o.no_ply;
+  write.write_glb = !o.no_glb;
+  write.floor_plan.resolution_m = float(o.resolution);
+  std::vector<PathUse> outputs;
+  for (const std::string& path : WorldFilePaths(o.out_dir, write))
+    outputs.push_back({"--out", path});
+  if (int code = RefusePathCollisions(
+          outputs, {{"--scene", o.scene}, {"--furniture-index", o.furniture_index}});
+      code != kExitOk)
+    return code;
 
   const Stopwatch clock;
   Result<World> world = Status(StatusCode::kInternal, "no world");
@@ -97,18 +111,15 @@ int RunSimScene(const SimSceneOptions& o) {
     }
   }
   const double build_ms = clock.ElapsedMs();
-  // The folder is made only once there is a world to write into it.
+  // The folder is made only once there is a world to write into it; every file lands, or none.
+  OutputTransaction transaction;
+  transaction.WatchFolder(o.out_dir);
   if (create_out && !fs::create_directory(out, ec))
     return Fail("cannot create output folder " + o.out_dir + ": " + ec.message());
-
-  WorldWriteOptions write;
-  write.basename = o.name;
-  write.write_ply = !o.no_ply;
-  write.write_glb = !o.no_glb;
-  write.floor_plan.resolution_m = float(o.resolution);
   const Stopwatch write_clock;
   Result<WrittenWorld> written = WriteWorld(world.value(), o.out_dir, write);
   if (!written.ok()) return Fail(written.status().message());
+  if (int code = CommitOutputs(transaction); code != kExitOk) return code;
   const double write_ms = write_clock.ElapsedMs();
 
   const FloorPlan& plan = written->floor_plan;

@@ -9,6 +9,7 @@
 
 #include "apps/voxplan/cli_common.h"
 #include "core/bounds.h"
+#include "apps/voxplan/path_check.h"
 #include "core/parallel.h"
 #include "io/tum_trajectory.h"
 #include "sim/floor_plan.h"
@@ -45,6 +46,8 @@ int RunSimTour(const SimTourOptions& o) {
   if (!fs::is_regular_file(o.scene, ec))
     return Fail("scene file not found: " + o.scene, kExitUsage);
   if (const std::string why = CheckOutputFile(o.out); !why.empty()) return Fail(why, kExitUsage);
+  if (int code = RefusePathCollisions({{"--out", o.out}}, {{"--scene", o.scene}}); code != kExitOk)
+    return code;
   TourParams params;
   params.mode = o.mode == "explorer" ? RobotMode::kExplorer : RobotMode::kReconstructor;
   params.robot.radius_m = float(o.radius);

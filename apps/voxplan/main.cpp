@@ -6,6 +6,7 @@
 #include <vector>
 
 #include "apps/voxplan/cli_common.h"
+#include "apps/voxplan/signals.h"
 
 int main(int argc, char** argv) {
   using namespace voxplan::cli;
@@ -35,6 +36,7 @@ int main(int argc, char** argv) {
     return kExitUsage;
   }
 
+  InstallSignalHandlers();
   try {
     return RunParsed(commands);
   } catch (const std::exception& e) {
