@@ -19,15 +19,20 @@
 
 namespace voxplan::dataset {
 
-Result<Pose3d> PoseFromMatrix(const Eigen::Matrix4d& m) {
-  VOXPLAN_RETURN_IF_ERROR(ValidatePoseMatrix(m));
+void SetMatrixPose(const Eigen::Matrix4d& m, const std::string& where, Entry& e, Draft& d) {
+  if (Status s = ValidatePoseMatrix(m); !s.ok()) {
+    e.T_W_C.reset();
+    e.pose_rejected = PoseRejection::kBadValues;
+    e.pose_rejected_why = where + ": " + s.message();
+    if (d.bad_poses++ == 0) d.first_bad_pose = e.pose_rejected_why;
+    return;
+  }
   Pose3d pose;
   pose.matrix() = m;
-  return pose;
+  e.T_W_C = pose;
 }
 
-// Rows of 4 numbers starting at lines[first]; errors name the first offending line.
-Result<Pose3d> ParseMatrixRows(const TextFile& f, size_t first) {
+Result<Eigen::Matrix4d> ParseMatrixRows(const TextFile& f, size_t first) {
   Eigen::Matrix4d m;
   for (int r = 0; r < 4; ++r) {
     if (first + size_t(r) >= f.lines.size())
@@ -38,9 +43,35 @@ Result<Pose3d> ParseMatrixRows(const TextFile& f, size_t first) {
     VOXPLAN_RETURN_IF_ERROR(ParseNumbers(f, line, 0, 4, row));
     for (int c = 0; c < 4; ++c) m(r, c) = row[c];
   }
-  auto pose = PoseFromMatrix(m);
-  if (!pose.ok()) return LineError(f.path, f.lines[first].number, pose.status().message());
-  return pose;
+  return m;
+}
+
+Status CheckFocalLengths(double fx, double fy, const std::string& file, int line) {
+  for (const auto& [name, v] : {std::pair{"fx", fx}, std::pair{"fy", fy}}) {
+    const std::string why =
+        std::string(name) + " " + NumberText(v) + " must be positive and finite";
+    if (!(v > 0.0) || !std::isfinite(v))
+      return line > 0 ? LineError(file, line, why) : CorruptData(file + ": " + why);
+  }
+  return Status::Ok();
+}
+
+int LineOf(const std::string& path, const std::string& text) {
+  auto content = ReadFileToString(path);
+  if (!content.ok()) return 0;
+  const size_t at = content->find(text);
+  if (at == std::string::npos) return 0;
+  return 1 + int(std::count(content->begin(), content->begin() + long(at), '\n'));
+}
+
+void WarnPoseCount(const std::string& pose_file, size_t poses, size_t frames, size_t matched,
+                   Draft& d) {
+  if (poses == frames && matched == frames) return;
+  std::string w =
+      pose_file + ": " + std::to_string(poses) + " poses for " + std::to_string(frames) + " frames";
+  if (matched < frames) w += "; " + std::to_string(frames - matched) + " frames have no pose";
+  if (poses > matched) w += "; " + std::to_string(poses - matched) + " poses match no frame";
+  d.warnings.push_back(w);
 }
 
 // Picks the depth path of a pair: the one mentioning "depth" when exactly one does (TUM's
@@ -101,6 +132,8 @@ class ListDataset final : public Dataset {
     frame.index = i;
     frame.timestamp = e.timestamp;
     frame.T_W_C = e.T_W_C;
+    frame.pose_rejected = e.pose_rejected;
+    frame.pose_rejected_why = e.pose_rejected_why;
     frame.depth_path = e.depth_path;
     frame.color_path = e.color_path;
     auto depth = ReadDepthPng(e.depth_path, info_.depth_scale);
@@ -165,6 +198,10 @@ Result<std::unique_ptr<Dataset>> Finish(Draft d, const DatasetOptions& options) 
   info.num_frames = d.entries.size();
   info.pose_source = d.pose_source;
   info.warnings = std::move(d.warnings);
+  if (d.bad_poses > 0)
+    info.warnings.push_back(
+        std::to_string(d.bad_poses) + (d.bad_poses == 1 ? " pose is" : " poses are") +
+        " not a rigid transform, those frames have no pose (first: " + d.first_bad_pose + ")");
 
   info.depth_scale = options.depth_scale ? *options.depth_scale : d.depth_scale;
   if (!(info.depth_scale > 0.0) || !std::isfinite(info.depth_scale))
@@ -303,6 +340,9 @@ Result<std::unique_ptr<Dataset>> OpenDataset(const std::string& path,
   fs::path root = fs::path(path).lexically_normal();
   if (root.filename().empty()) root = root.parent_path();
 
+  if (!(options.max_pose_gap_s > 0.0) || !std::isfinite(options.max_pose_gap_s))
+    return InvalidArgument("max pose gap must be positive and finite, got " +
+                           NumberText(options.max_pose_gap_s) + " s");
   DatasetFormat format = options.format;
   if (format == DatasetFormat::kAuto) {
     auto detected = DetectFormat(root);
@@ -312,7 +352,7 @@ Result<std::unique_ptr<Dataset>> OpenDataset(const std::string& path,
   Result<Draft> draft = Status(StatusCode::kInternal, "unreachable");
   switch (format) {
     case DatasetFormat::kTum:
-      draft = ReadTum(root);
+      draft = ReadTum(root, options.max_pose_gap_s);
       break;
     case DatasetFormat::kIclNuim:
       draft = ReadIclNuim(root);

@@ -23,6 +23,9 @@ struct DatasetOptions {
   DatasetFormat format = DatasetFormat::kAuto;
   std::optional<PinholeCamera> intrinsics;  // overrides fx fy cx cy (size comes from the images)
   std::optional<double> depth_scale;        // depth units per metre
+  // Timestamped ground truth (TUM): a frame is not interpolated between two poses further apart
+  // than this (seconds); it gets no pose, PoseRejection::kGroundTruthGap.
+  double max_pose_gap_s = 0.1;
 };
 
 struct DatasetInfo {
@@ -37,12 +40,21 @@ struct DatasetInfo {
   std::vector<std::string> warnings;  // one line each, e.g. frames dropped for lack of poses
 };
 
+// Why a frame has no pose although its dataset lists one for it (or around it).
+enum class PoseRejection {
+  kNone,
+  kBadValues,       // the listed pose is not a rigid transform (NaN, inf, not a rotation)
+  kGroundTruthGap,  // between two ground-truth poses further apart than max_pose_gap_s
+};
+
 struct Frame {
   size_t index = 0;        // 0-based position in the sequence
   double timestamp = 0.0;  // seconds (frame id or index / 30 Hz where the dataset has none)
   DepthImage depth;        // metres, 0 = invalid
   ColorImage color;        // empty when the dataset has no colour
   std::optional<Pose3d> T_W_C;
+  PoseRejection pose_rejected = PoseRejection::kNone;  // set only when T_W_C is empty
+  std::string pose_rejected_why;                       // "file:line: reason"
   std::string depth_path;
   std::string color_path;  // empty when the dataset has no colour
 };

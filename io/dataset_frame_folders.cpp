@@ -81,8 +81,10 @@ Status ReadCameraIntrinsicsTxt(const std::string& path, Draft& d) {
       if (!std::isfinite(k[3 * r + size_t(c)]))
         return LineError(path, line.number, "non-finite value");
   }
-  if (k[0] == 0.0 || k[4] == 0.0 || k[6] != 0.0 || k[7] != 0.0 || k[8] != 1.0)
-    return LineError(path, file->lines[0].number, "not a pinhole matrix [fx 0 cx; 0 fy cy; 0 0 1]");
+  if (k[6] != 0.0 || k[7] != 0.0 || k[8] != 1.0)
+    return LineError(path, file->lines[2].number, "not a pinhole matrix [fx 0 cx; 0 fy cy; 0 0 1]");
+  VOXPLAN_RETURN_IF_ERROR(CheckFocalLengths(k[0], 1.0, path, file->lines[0].number));
+  VOXPLAN_RETURN_IF_ERROR(CheckFocalLengths(1.0, k[4], path, file->lines[1].number));
   d.intrinsics[0] = float(k[0]);
   d.intrinsics[1] = float(k[4]);
   d.intrinsics[2] = float(k[2]);
@@ -111,9 +113,9 @@ Status AddFrameFolder(const fs::path& dir, double time_offset, Draft& d, double*
       if (file->lines.size() != 4)
         return CorruptData(pose_path + ": expected a 4x4 matrix (4 lines), found " +
                            std::to_string(file->lines.size()));
-      auto pose = ParseMatrixRows(*file, 0);
-      if (!pose.ok()) return pose.status();
-      e.T_W_C = *pose;
+      auto matrix = ParseMatrixRows(*file, 0);
+      if (!matrix.ok()) return matrix.status();
+      SetMatrixPose(*matrix, pose_path + ":" + std::to_string(file->lines[0].number), e, d);
     } else {
       ++missing_poses;
       d.warnings.push_back(pose_path + ": not found; frame kept with no pose");

@@ -35,6 +35,8 @@ struct Entry {
   std::string color_path;  // empty: no colour
   double timestamp = 0.0;
   std::optional<Pose3d> T_W_C;
+  PoseRejection pose_rejected = PoseRejection::kNone;  // why T_W_C is empty, when listed
+  std::string pose_rejected_why;
   std::string origin;  // "file:line" the entry came from, for error messages
 };
 
@@ -50,23 +52,38 @@ struct Draft {
   int stated_width = 0, stated_height = 0;  // from the intrinsics file, when it states a size
   std::string pose_source = "none";
   std::vector<std::string> warnings;
-  std::string empty_message;  // why there are no frames, when there are none
+  std::string empty_message;   // why there are no frames, when there are none
+  size_t bad_poses = 0;        // listed poses rejected as kBadValues; Finish warns once
+  std::string first_bad_pose;  // "file:line: reason" of the first
 };
 
 inline void SetIntrinsics(Draft& d, const float (&k)[4]) { std::copy(k, k + 4, d.intrinsics); }
 
 // The readers, one per format family; each returns a Draft for OpenDataset to finish.
-Result<Draft> ReadTum(const fs::path& root);      // io/dataset_tum.cpp
-Result<Draft> ReadIclNuim(const fs::path& root);  // io/dataset_tum.cpp
-Result<Draft> ReadRedwood(const fs::path& root);  // io/dataset_redwood.cpp
+Result<Draft> ReadTum(const fs::path& root, double max_pose_gap_s);  // io/dataset_tum.cpp
+Result<Draft> ReadIclNuim(const fs::path& root);                     // io/dataset_tum.cpp
+Result<Draft> ReadRedwood(const fs::path& root);                     // io/dataset_redwood.cpp
 // 7-Scenes and 3DMatch; io/dataset_frame_folders.cpp.
 Result<Draft> ReadFrameFolders(const fs::path& root, DatasetFormat format);
 Result<Draft> ReadReplica(const fs::path& root);  // io/dataset_replica.cpp
 
 // Helpers more than one reader uses, in io/dataset.cpp.
-Result<Pose3d> PoseFromMatrix(const Eigen::Matrix4d& m);  // checked by ValidatePoseMatrix
+// A pose read as a 4x4 matrix at `where` ("file:line"): a rigid one (ValidatePoseMatrix) becomes
+// e.T_W_C; any other leaves the frame without a pose, rejected as kBadValues and counted in d,
+// so that one bad pose (7-Scenes and 3DMatch write -inf where tracking was lost) costs a frame,
+// not the dataset.
+void SetMatrixPose(const Eigen::Matrix4d& m, const std::string& where, Entry& e, Draft& d);
 // Rows of 4 numbers starting at lines[first]; errors name the first offending line.
-Result<Pose3d> ParseMatrixRows(const TextFile& f, size_t first);
+Result<Eigen::Matrix4d> ParseMatrixRows(const TextFile& f, size_t first);
+// Refuses focal lengths read from `file` that are not positive and finite, as file:line.
+// (ICL-NUIM's negative fy is the format's convention, a built-in default no file states.)
+Status CheckFocalLengths(double fx, double fy, const std::string& file, int line);
+// The 1-based line of the first occurrence of `text` in `path` (for JSON values), else 0.
+int LineOf(const std::string& path, const std::string& text);
+// Warns, naming both numbers, when a pose list holds a different number of poses than there
+// are frames; `matched`: frames that got one of them.
+void WarnPoseCount(const std::string& pose_file, size_t poses, size_t frames, size_t matched,
+                   Draft& d);
 // Picks the depth path of a pair: the one mentioning "depth" when exactly one does (TUM's
 // associate.py writes rgb first, ICL-NUIM writes depth first); otherwise `default_first`.
 bool DepthIsFirst(const std::string& a, const std::string& b, bool default_first);

@@ -56,8 +56,9 @@ Status ReadRedwoodCamera(const std::string& path, Draft& d) {
     k[i] = v.get<double>();
   }
   // Column-major: [fx 0 0, 0 fy 0, cx cy 1].
-  if (k[0] == 0.0 || k[4] == 0.0 || k[8] != 1.0)
+  if (k[8] != 1.0)
     return CorruptData(path + ": intrinsic_matrix is not a pinhole matrix (column-major)");
+  VOXPLAN_RETURN_IF_ERROR(CheckFocalLengths(k[0], k[4], path, LineOf(path, "intrinsic_matrix")));
   d.intrinsics[0] = float(k[0]);
   d.intrinsics[1] = float(k[4]);
   d.intrinsics[2] = float(k[6]);
@@ -74,11 +75,131 @@ Status ReadRedwoodCamera(const std::string& path, Draft& d) {
   return Status::Ok();
 }
 
-// Redwood .log: blocks of a `i j n` line and four matrix rows; the first id is the frame index.
-Result<std::map<long, Pose3d>> ReadRedwoodLog(const std::string& path) {
+// The frame number in a file name: the last run of digits of its stem ("00012.png",
+// "depth_12.png": 12), or -1. Poses are associated by it, never by list position, so that a
+// missing file or unpadded names ("10.png" sorting before "2.png") cannot shift them.
+long FrameNumber(const std::string& path) {
+  const std::string stem = fs::path(path).stem().string();
+  size_t end = stem.size();
+  while (end > 0 && !std::isdigit(static_cast<unsigned char>(stem[end - 1]))) --end;
+  size_t begin = end;
+  while (begin > 0 && std::isdigit(static_cast<unsigned char>(stem[begin - 1]))) --begin;
+  if (begin == end || end - begin > 9) return -1;
+  return std::stol(stem.substr(begin, end - begin));
+}
+
+// Files sorted by frame number; a file without one, or two with the same, is refused.
+Result<std::vector<std::pair<long, std::string>>> Numbered(const std::vector<std::string>& files) {
+  std::vector<std::pair<long, std::string>> out;
+  for (const std::string& f : files) {
+    const long id = FrameNumber(f);
+    if (id < 0)
+      return CorruptData(f + ": no frame number in the file name (poses are matched by it)");
+    out.emplace_back(id, f);
+  }
+  std::sort(out.begin(), out.end());
+  for (size_t i = 1; i < out.size(); ++i)
+    if (out[i].first == out[i - 1].first)
+      return CorruptData(out[i].second + ": duplicate frame number " +
+                         std::to_string(out[i].first) + " (also " + out[i - 1].second + ")");
+  return out;
+}
+
+// Frames as rgbd.match pairs them, in its order; returns their frame numbers.
+Result<std::vector<long>> ListMatched(const fs::path& root, const std::string& match, Draft& d) {
+  auto file = ReadTextFile(match);
+  if (!file.ok()) return file.status();
+  std::vector<long> ids;
+  std::map<long, int> seen;  // frame number -> line
+  for (const TextLine& line : file->lines) {
+    VOXPLAN_RETURN_IF_ERROR(ExpectTokens(*file, line, 2, "depth_path color_path"));
+    const bool depth_first = DepthIsFirst(line.tokens[0], line.tokens[1], true);
+    Entry e;
+    e.depth_path = (root / line.tokens[depth_first ? 0 : 1]).string();
+    e.color_path = (root / line.tokens[depth_first ? 1 : 0]).string();
+    e.origin = match + ":" + std::to_string(line.number);
+    const long id = FrameNumber(e.depth_path);
+    if (id < 0)
+      return LineError(
+          match, line.number,
+          "no frame number in " + line.tokens[depth_first ? 0 : 1] + " (poses are matched by it)");
+    if (auto [it, fresh] = seen.emplace(id, line.number); !fresh)
+      return LineError(match, line.number,
+                       "frame number " + std::to_string(id) + " already listed at line " +
+                           std::to_string(it->second));
+    ids.push_back(id);
+    d.entries.push_back(std::move(e));
+  }
+  d.empty_message = match + ": no frames listed";
+  return ids;
+}
+
+// Frames of depth/ (and color/, paired by frame number), sorted by number.
+Result<std::vector<long>> ListFolders(const fs::path& root, Draft& d) {
+  std::error_code ec;
+  if (!fs::is_directory(root / "depth", ec))
+    return NotFound((root / "depth").string() + ": depth folder not found");
+  auto depth_files = ListFiles(root / "depth", {".png"});
+  if (!depth_files.ok()) return depth_files.status();
+  auto color_files = ListFiles(root / "color", {".jpg", ".jpeg", ".png"});
+  if (!color_files.ok()) return color_files.status();
+  auto depth = Numbered(*depth_files);
+  if (!depth.ok()) return depth.status();
+  auto color = Numbered(*color_files);
+  if (!color.ok()) return color.status();
+  const std::map<long, std::string> color_by_id(color->begin(), color->end());
+  std::vector<long> ids;
+  size_t paired = 0;
+  for (const auto& [id, path] : *depth) {
+    Entry e;
+    e.depth_path = path;
+    if (auto it = color_by_id.find(id); it != color_by_id.end()) {
+      e.color_path = it->second;
+      ++paired;
+    } else if (!color_by_id.empty()) {
+      return NotFound(path + ": no colour image with frame number " + std::to_string(id) + " in " +
+                      (root / "color").string() + "; add an rgbd.match file to pair them");
+    }
+    ids.push_back(id);
+    d.entries.push_back(std::move(e));
+  }
+  if (paired < color->size())
+    d.warnings.push_back((root / "color").string() + ": " + std::to_string(color->size() - paired) +
+                         " of " + std::to_string(color->size()) +
+                         " colour images have no depth image of the same number; unused");
+  d.empty_message = (root / "depth").string() + ": no PNG images";
+  return ids;
+}
+
+// Missing frame numbers between the first and the last frame: how many, and the first.
+void WarnNumberingGaps(const fs::path& root, const std::vector<long>& ids, Draft& d) {
+  if (ids.size() < 2) return;
+  std::vector<long> sorted = ids;
+  std::sort(sorted.begin(), sorted.end());
+  long missing = 0, first_missing = -1;
+  for (size_t i = 1; i < sorted.size(); ++i) {
+    const long gap = sorted[i] - sorted[i - 1] - 1;
+    if (gap > 0 && first_missing < 0) first_missing = sorted[i - 1] + 1;
+    missing += gap;
+  }
+  if (missing > 0)
+    d.warnings.push_back(root.string() + ": " + std::to_string(missing) +
+                         " frame numbers missing between " + std::to_string(sorted.front()) +
+                         " and " + std::to_string(sorted.back()) +
+                         " (first: " + std::to_string(first_missing) +
+                         "); poses follow the numbers in the file names");
+}
+
+struct LoggedPose {
+  Eigen::Matrix4d matrix;
+  int line = 0;
+};
+
+// Redwood .log: blocks of a `i j n` line and four matrix rows; the first id is the frame number.
+Result<std::map<long, LoggedPose>> ReadRedwoodLog(const std::string& path) {
   auto file = ReadTextFile(path);
   if (!file.ok()) return file.status();
-  std::map<long, Pose3d> poses;
+  std::map<long, LoggedPose> poses;
   long prev = -1;
   for (size_t i = 0; i < file->lines.size(); i += 5) {
     const TextLine& meta = file->lines[i];
@@ -92,9 +213,10 @@ Result<std::map<long, Pose3d>> ReadRedwoodLog(const std::string& path) {
     if (id < prev)
       return LineError(path, meta.number, "frame id " + meta.tokens[0] + " out of order");
     prev = id;
-    auto pose = ParseMatrixRows(*file, i + 1);
-    if (!pose.ok()) return pose.status();
-    poses.emplace(id, *pose);
+    auto matrix = ParseMatrixRows(*file, i + 1);
+    if (!matrix.ok()) return matrix.status();
+    poses.emplace(id, LoggedPose{*matrix, i + 1 < file->lines.size() ? file->lines[i + 1].number
+                                                                     : meta.number});
   }
   if (poses.empty()) return CorruptData(path + ": no poses");
   return poses;
@@ -130,63 +252,35 @@ Result<Draft> ReadRedwood(const fs::path& root) {
   }
 
   const std::string match = (root / "rgbd.match").string();
-  if (fs::exists(match, ec)) {
-    auto file = ReadTextFile(match);
-    if (!file.ok()) return file.status();
-    for (const TextLine& line : file->lines) {
-      VOXPLAN_RETURN_IF_ERROR(ExpectTokens(*file, line, 2, "depth_path color_path"));
-      const bool depth_first = DepthIsFirst(line.tokens[0], line.tokens[1], true);
-      Entry e;
-      e.depth_path = (root / line.tokens[depth_first ? 0 : 1]).string();
-      e.color_path = (root / line.tokens[depth_first ? 1 : 0]).string();
-      e.origin = match + ":" + std::to_string(line.number);
-      d.entries.push_back(std::move(e));
-    }
-    d.empty_message = match + ": no frames listed";
-  } else {
-    if (!fs::is_directory(root / "depth", ec))
-      return NotFound((root / "depth").string() + ": depth folder not found");
-    auto depth = ListFiles(root / "depth", {".png"});
-    if (!depth.ok()) return depth.status();
-    auto color = ListFiles(root / "color", {".jpg", ".jpeg", ".png"});
-    if (!color.ok()) return color.status();
-    if (!color->empty() && color->size() != depth->size())
-      return CorruptData((root / "color").string() + ": " + std::to_string(color->size()) +
-                         " images but depth/ has " + std::to_string(depth->size()) +
-                         "; add an rgbd.match file to pair them");
-    for (size_t i = 0; i < depth->size(); ++i) {
-      Entry e;
-      e.depth_path = (*depth)[i];
-      if (!color->empty()) e.color_path = (*color)[i];
-      d.entries.push_back(std::move(e));
-    }
-    d.empty_message = (root / "depth").string() + ": no PNG images";
-  }
+  auto ids = fs::exists(match, ec) ? ListMatched(root, match, d) : ListFolders(root, d);
+  if (!ids.ok()) return ids.status();
+  WarnNumberingGaps(root, *ids, d);
   for (size_t i = 0; i < d.entries.size(); ++i)
-    d.entries[i].timestamp = double(i) / kNoTimestampRateHz;
+    d.entries[i].timestamp = double((*ids)[i]) / kNoTimestampRateHz;
 
   std::string log = (root / "trajectory.log").string();
   if (!fs::exists(log, ec)) log = (root / "odometry.log").string();
-  if (fs::exists(log, ec)) {
-    auto poses = ReadRedwoodLog(log);
-    if (!poses.ok()) return poses.status();
-    d.pose_source = log;
-    for (size_t i = 0; i < d.entries.size(); ++i) {
-      auto it = poses->find(long(i));
-      if (it != poses->end()) {
-        d.entries[i].T_W_C = it->second;
-      } else {
-        d.warnings.push_back(log + ": no pose for frame " + std::to_string(i) + " (" +
-                             Rel(d.root, d.entries[i].depth_path) + ")");
-      }
-    }
-    if (poses->size() > d.entries.size())
-      d.warnings.push_back(log + ": " + std::to_string(poses->size()) + " poses for " +
-                           std::to_string(d.entries.size()) + " frames; extra poses ignored");
-  } else {
+  if (!fs::exists(log, ec)) {
     d.warnings.push_back(root.string() +
                          ": no trajectory.log or odometry.log; frames have no pose");
+    return d;
   }
+  auto poses = ReadRedwoodLog(log);
+  if (!poses.ok()) return poses.status();
+  d.pose_source = log;
+  size_t matched = 0;
+  for (size_t i = 0; i < d.entries.size(); ++i) {
+    auto it = poses->find((*ids)[i]);
+    if (it == poses->end()) {
+      if (i - matched < 5)  // name the first few; WarnPoseCount counts them all
+        d.warnings.push_back(log + ": no pose for frame " + std::to_string((*ids)[i]) + " (" +
+                             Rel(d.root, d.entries[i].depth_path) + ")");
+      continue;
+    }
+    SetMatrixPose(it->second.matrix, log + ":" + std::to_string(it->second.line), d.entries[i], d);
+    ++matched;
+  }
+  WarnPoseCount(log, poses->size(), d.entries.size(), matched, d);
   return d;
 }
 

@@ -67,6 +67,8 @@ Result<Draft> ReadReplica(const fs::path& root) {
   d.intrinsics[3] = float(v[5]);
   d.depth_scale = v[6];
   d.intrinsics_source = params;
+  VOXPLAN_RETURN_IF_ERROR(CheckFocalLengths(v[2], 1.0, params, LineOf(params, "\"fx\"")));
+  VOXPLAN_RETURN_IF_ERROR(CheckFocalLengths(1.0, v[3], params, LineOf(params, "\"fy\"")));
 
   const fs::path results = scene / "results";
   auto depth = ListFrames(results, "depth", ".png");
@@ -89,26 +91,29 @@ Result<Draft> ReadReplica(const fs::path& root) {
   if (fs::exists(traj, ec)) {
     auto file = ReadTextFile(traj);
     if (!file.ok()) return file.status();
-    std::vector<Pose3d> poses;
+    std::vector<std::pair<Eigen::Matrix4d, int>> poses;  // matrix, line
     poses.reserve(file->lines.size());
     for (const TextLine& line : file->lines) {
       VOXPLAN_RETURN_IF_ERROR(ExpectTokens(*file, line, 16, "16 numbers, a row-major 4x4"));
       double m[16];
       VOXPLAN_RETURN_IF_ERROR(ParseNumbers(*file, line, 0, 16, m));
-      auto pose = PoseFromMatrix(Eigen::Map<const Eigen::Matrix<double, 4, 4, Eigen::RowMajor>>(m));
-      if (!pose.ok()) return LineError(traj, line.number, pose.status().message());
-      poses.push_back(*pose);
+      poses.push_back(
+          {Eigen::Map<const Eigen::Matrix<double, 4, 4, Eigen::RowMajor>>(m), line.number});
     }
     d.pose_source = traj;
+    size_t matched = 0;
     for (size_t i = 0; i < d.entries.size(); ++i) {
       const long id = (*depth)[i].first;
       if (size_t(id) < poses.size()) {
-        d.entries[i].T_W_C = poses[size_t(id)];
+        const auto& [matrix, number] = poses[size_t(id)];
+        SetMatrixPose(matrix, traj + ":" + std::to_string(number), d.entries[i], d);
+        ++matched;
       } else {
         d.warnings.push_back(traj + ": no pose for frame " + std::to_string(id) + " (" +
                              std::to_string(poses.size()) + " poses); kept with no pose");
       }
     }
+    WarnPoseCount(traj, poses.size(), d.entries.size(), matched, d);
   } else {
     d.warnings.push_back(traj + ": not found; frames have no pose");
   }

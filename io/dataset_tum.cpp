@@ -72,8 +72,10 @@ Pose3d ToPose(const Eigen::Vector3d& t, const Eigen::Quaterniond& q) {
 }
 
 // Pose at time t between the two bracketing poses (lerp translation, slerp rotation); none when
-// t is outside the trajectory.
-std::optional<Pose3d> InterpolatePose(const std::vector<StampedPose>& poses, double t) {
+// t is outside the trajectory, or when the bracketing poses are more than `max_gap` apart (then
+// *gap_from / *gap_to are set: the motion across a gap is unknown, interpolating it invents one).
+std::optional<Pose3d> InterpolatePose(const std::vector<StampedPose>& poses, double t,
+                                      double max_gap, double* gap_from, double* gap_to) {
   auto it = std::lower_bound(poses.begin(), poses.end(), t,
                              [](const StampedPose& p, double v) { return p.t < v; });
   if (it == poses.end()) return std::nullopt;
@@ -81,6 +83,11 @@ std::optional<Pose3d> InterpolatePose(const std::vector<StampedPose>& poses, dou
   if (it == poses.begin()) return std::nullopt;
   const StampedPose& a = *(it - 1);
   const StampedPose& b = *it;
+  if (b.t - a.t > max_gap + 1e-9) {  // a 10 Hz trajectory is not refused for rounding
+    *gap_from = a.t;
+    *gap_to = b.t;
+    return std::nullopt;
+  }
   const double alpha = (t - a.t) / (b.t - a.t);
   return ToPose((1.0 - alpha) * a.translation + alpha * b.translation,
                 a.rotation.slerp(alpha, b.rotation));
@@ -88,7 +95,7 @@ std::optional<Pose3d> InterpolatePose(const std::vector<StampedPose>& poses, dou
 
 }  // namespace
 
-Result<Draft> ReadTum(const fs::path& root) {
+Result<Draft> ReadTum(const fs::path& root, double max_pose_gap_s) {
   Draft d;
   d.format = DatasetFormat::kTum;
   d.root = root.string();
@@ -115,8 +122,7 @@ Result<Draft> ReadTum(const fs::path& root) {
     VOXPLAN_RETURN_IF_ERROR(ParseNumbers(*file, line, 0, 4, k));
     for (double v : k)
       if (!std::isfinite(v)) return LineError(camera_txt, line.number, "intrinsics must be finite");
-    if (k[0] == 0.0 || k[1] == 0.0)
-      return LineError(camera_txt, line.number, "fx and fy must be non-zero");
+    VOXPLAN_RETURN_IF_ERROR(CheckFocalLengths(k[0], k[1], camera_txt, line.number));
     const float kf[4] = {float(k[0]), float(k[1]), float(k[2]), float(k[3])};
     SetIntrinsics(d, kf);
     d.intrinsics_source = camera_txt;
@@ -149,7 +155,8 @@ Result<Draft> ReadTum(const fs::path& root) {
     d.warnings.push_back(gt_txt + ": not found; frames have no pose");
   }
 
-  size_t no_rgb = 0, no_pose = 0;
+  size_t no_rgb = 0, no_pose = 0, in_gap = 0;
+  std::string first_gap;
   for (const Stamped& s : *depth) {
     const std::string where = depth_txt + ":" + std::to_string(s.line);
     Entry e;
@@ -171,8 +178,18 @@ Result<Draft> ReadTum(const fs::path& root) {
       e.color_path = (root / best->path).string();
     }
     if (have_gt) {
-      e.T_W_C = InterpolatePose(gt, s.t);
-      if (!e.T_W_C) {
+      double gap_from = 0.0, gap_to = 0.0;
+      e.T_W_C = InterpolatePose(gt, s.t, max_pose_gap_s, &gap_from, &gap_to);
+      if (!e.T_W_C && gap_to > gap_from) {
+        // Kept without a pose, so that fusion counts it as skipped for the gap.
+        ++in_gap;
+        e.pose_rejected = PoseRejection::kGroundTruthGap;
+        e.pose_rejected_why =
+            where + ": depth " + NumberText(s.t) + " lies in a " + NumberText(gap_to - gap_from) +
+            " s gap of " + gt_txt + " (" + NumberText(gap_from) + " to " + NumberText(gap_to) +
+            "), longer than the " + NumberText(max_pose_gap_s) + " s allowed for interpolation";
+        if (in_gap == 1) first_gap = e.pose_rejected_why;
+      } else if (!e.T_W_C) {
         ++no_pose;
         d.warnings.push_back(where + ": depth " + NumberText(s.t) +
                              " has no bracketing ground-truth poses; frame dropped");
@@ -181,6 +198,9 @@ Result<Draft> ReadTum(const fs::path& root) {
     }
     d.entries.push_back(std::move(e));
   }
+  if (in_gap > 0)
+    d.warnings.push_back(std::to_string(in_gap) + " depth frames have no pose: they lie in gaps " +
+                         "of the ground truth (first: " + first_gap + ")");
   d.empty_message = depth_txt + ": no frame associates (" + std::to_string(depth->size()) +
                     " depth frames: " + std::to_string(no_rgb) + " with no frame of " + rgb_txt +
                     " within 0.02 s, " + std::to_string(no_pose) + " without bracketing poses in " +
@@ -252,6 +272,11 @@ Result<Draft> ReadIclNuim(const fs::path& root) {
                            *gt_path + "; kept with no pose");
     }
     d.entries.push_back(std::move(e));
+  }
+  if (gt_path.ok()) {
+    const size_t matched = size_t(std::count_if(
+        d.entries.begin(), d.entries.end(), [](const Entry& e) { return e.T_W_C.has_value(); }));
+    WarnPoseCount(*gt_path, poses.size(), d.entries.size(), matched, d);
   }
   d.empty_message = assoc_txt + ": no frames listed";
   return d;

@@ -7,6 +7,7 @@
 
 #include "core/bounds.h"
 #include "core/stopwatch.h"
+#include "pipeline/frame_checks.h"
 
 namespace voxplan {
 
@@ -70,6 +71,35 @@ Status CountOverBudget(const IntegrateStats& stats, const Frame& frame, const Fu
   return Status::Ok();
 }
 
+// The skip counters of frames whose dataset pose cannot be used.
+struct PoseSkips {
+  SkipCounter none, bad, gap;
+  void Finish() const {
+    none.Finish();
+    bad.Finish();
+    gap.Finish();
+  }
+};
+
+// The dataset's pose of a frame when it can be trusted; else the frame is counted as skipped
+// for the reason.
+std::optional<Pose3f> DatasetPose(const Frame& frame, const FuseParams& params,
+                                  const VolumeParams& volume, PoseSkips& skips) {
+  if (frame.T_W_C) {
+    const std::string why = PoseProblem(*frame.T_W_C, params.max_pose_translation_m, volume,
+                                        params.integrate.max_depth_m);
+    if (why.empty()) return Pose3f(frame.T_W_C->cast<float>());
+    skips.bad.Skip(frame, "has a pose not to trust (" + why + "); skipped");
+  } else if (frame.pose_rejected == PoseRejection::kBadValues) {
+    skips.bad.Skip(frame, "has a pose not to trust (" + frame.pose_rejected_why + "); skipped");
+  } else if (frame.pose_rejected == PoseRejection::kGroundTruthGap) {
+    skips.gap.Skip(frame, "has no pose (" + frame.pose_rejected_why + "); skipped");
+  } else {
+    skips.none.Skip(frame, "has no pose; skipped");
+  }
+  return std::nullopt;
+}
+
 }  // namespace
 
 Result<FuseReport> FuseDataset(const Dataset& dataset, const std::vector<size_t>& indices,
@@ -92,7 +122,11 @@ Result<FuseReport> FuseDataset(const Dataset& dataset, const std::vector<size_t>
   FuseReport report;
   report.frames_selected = indices.size();
   SkipCounter no_depth(observer, params.max_skip_warnings, "had no valid depth and were skipped");
-  SkipCounter no_pose(observer, params.max_skip_warnings, "had no pose and were skipped");
+  PoseSkips pose_skips{
+      {observer, params.max_skip_warnings, "had no pose and were skipped"},
+      {observer, params.max_skip_warnings, "had a pose not to trust and were skipped"},
+      {observer, params.max_skip_warnings, "lay in gaps of the ground truth and were skipped"}};
+  DepthScaleCheck depth_check(info.root, info.depth_scale);
   SkipCounter lost(observer, params.max_skip_warnings, "lost tracking and were not integrated");
   const Stopwatch loop_clock;
   for (size_t k = 0; k < indices.size(); ++k) {
@@ -109,6 +143,8 @@ Result<FuseReport> FuseDataset(const Dataset& dataset, const std::vector<size_t>
       if (observer.progress) observer.progress(k + 1, indices.size());
       continue;
     }
+    if (auto w = depth_check.Add(frame->depth, frame->depth_path); w && observer.warning)
+      observer.warning(*w);
     std::optional<Pose3f> T_W_C;
     if (tracker && !tracker_started) {
       T_W_C = frame->T_W_C ? Pose3f(frame->T_W_C->cast<float>()) : Pose3f::Identity();
@@ -124,10 +160,8 @@ Result<FuseReport> FuseDataset(const Dataset& dataset, const std::vector<size_t>
       } else {
         lost.Skip(*frame, "lost tracking (" + tracked->failure + "); not integrated");
       }
-    } else if (frame->T_W_C) {
-      T_W_C = frame->T_W_C->cast<float>();
     } else {
-      no_pose.Skip(*frame, "has no pose; skipped");
+      T_W_C = DatasetPose(*frame, params, volume.params(), pose_skips);
     }
     if (T_W_C) {
       const Stopwatch integrate_clock;
@@ -148,10 +182,15 @@ Result<FuseReport> FuseDataset(const Dataset& dataset, const std::vector<size_t>
     if (observer.progress) observer.progress(k + 1, indices.size());
   }
   report.loop_s = loop_clock.ElapsedS();
-  no_pose.Finish();
+  if (auto w = depth_check.Finish(); w && observer.warning) observer.warning(*w);
+  pose_skips.Finish();
   lost.Finish();
   no_depth.Finish();
-  report.skipped_no_pose = no_pose.count();
+  report.skipped_no_pose = pose_skips.none.count();
+  report.skipped_bad_pose = pose_skips.bad.count();
+  report.skipped_pose_gap = pose_skips.gap.count();
+  report.first_frames_median_depth_m = depth_check.median_m();
+  report.suggested_depth_scale = depth_check.suggested_scale();
   report.skipped_no_depth = no_depth.count();
   report.frames_lost = lost.count();
   return report;

@@ -3,8 +3,9 @@
 // demo and the tests share. Per selected frame: load, skip a frame without valid depth, choose
 // the pose (the dataset's, or with tracking the tracker's: the first frame starts from the
 // dataset pose, else the identity; a frame that loses tracking is not integrated), integrate,
-// record. Counts and timings come back in the report; progress and warnings go to the
-// observer, never printed here.
+// record. A dataset pose fails PoseProblem (pipeline/frame_checks.h) or the reader rejected it:
+// skipped and counted; the first frames' depth is checked for a wrong depth scale. Counts and
+// timings come back in the report; progress and warnings go to the observer, never printed here.
 #include <cstddef>
 #include <functional>
 #include <string>
@@ -35,6 +36,10 @@ struct FuseParams {
   // a warning each; beyond, one warning at the end gives the count.
   int max_skip_warnings = 5;
 
+  // A dataset pose translated further than this from the origin is not trusted (skipped and
+  // counted, as are non-rigid ones and, always, ones whose view leaves the block index range).
+  double max_pose_translation_m = 1e4;
+
   Status Validate() const { return integrate.Validate(); }
 };
 
@@ -49,6 +54,11 @@ struct FuseReport {
   std::vector<FusedFrame> frames;  // the integrated frames, in order
   size_t frames_selected = 0;
   size_t skipped_no_pose = 0, skipped_no_depth = 0;
+  size_t skipped_bad_pose = 0;  // a pose not to trust (frame_checks.h PoseProblem, or the reader's)
+  size_t skipped_pose_gap = 0;  // in a gap of timestamped ground truth, not interpolated
+  // The median valid depth of the first frames and, when it is out of range, the likely depth
+  // scale (0: none); see frame_checks.h DepthScaleCheck.
+  double first_frames_median_depth_m = 0.0, suggested_depth_scale = 0.0;
   size_t frames_lost = 0;  // tracking only: lost, not integrated
   // Past the memory budget: new blocks not allocated, and the frames that had some.
   size_t blocks_refused = 0, frames_over_budget = 0;

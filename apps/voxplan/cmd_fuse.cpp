@@ -44,6 +44,7 @@ struct FuseOptions {
   bool track = false;
   double photometric_weight = 0.0;
   MemoryBudgetOptions memory;
+  double max_pose_gap_s = 0.1;
 };
 
 nlohmann::json OrNull(const std::string& path) {
@@ -65,8 +66,12 @@ nlohmann::json FuseStats(const FuseOptions& o, const DatasetInfo& info,
   j["format"] = DatasetFormatName(info.format);
   j["frames"] = integrated;
   j["frames_selected"] = report.frames_selected;
-  j["frames_skipped"] = report.skipped_no_pose + report.skipped_no_depth;
+  j["frames_skipped"] = report.skipped_no_pose + report.skipped_no_depth + report.skipped_bad_pose +
+                        report.skipped_pose_gap;
   j["frames_skipped_no_pose"] = report.skipped_no_pose;
+  j["frames_skipped_bad_pose"] = report.skipped_bad_pose;
+  j["frames_skipped_pose_gap"] = report.skipped_pose_gap;
+  j["max_pose_gap_s"] = o.max_pose_gap_s;
   j["tracking"] = o.track;
   j["frames_lost"] = report.frames_lost;
   j["track_ms_median"] = RoundTo(Summarize(report.track_ms).median, 3);
@@ -82,6 +87,10 @@ nlohmann::json FuseStats(const FuseOptions& o, const DatasetInfo& info,
   j["kernel"] = KernelName(ResolveKernel(params.kernel));
   j["camera"] = CameraJson(info.camera);
   j["depth_scale"] = info.depth_scale;
+  j["depth_median_first_frames_m"] = RoundTo(report.first_frames_median_depth_m, 4);
+  j["depth_scale_suggested"] = report.suggested_depth_scale > 0.0
+                                   ? nlohmann::json(report.suggested_depth_scale)
+                                   : nlohmann::json(nullptr);
   j["integrate_ms_median"] = RoundTo(integrate_t.median, 3);
   j["integrate_ms_p90"] = RoundTo(integrate_t.p90, 3);
   j["integrate_ms_mean"] = RoundTo(integrate_t.mean, 3);
@@ -128,6 +137,7 @@ int RunFuse(const FuseOptions& o) {
     dataset_options.intrinsics = *camera;
   }
   if (o.depth_scale > 0.0) dataset_options.depth_scale = o.depth_scale;
+  dataset_options.max_pose_gap_s = o.max_pose_gap_s;
 
   ThreadLimit thread_limit(o.threads);
   OpenedDataset opened;
@@ -254,6 +264,11 @@ Command AddFuseCommand(CLI::App& app) {
   sub->add_option("--photometric-weight", o->photometric_weight,
                   "With --track: weight of the colour term (0: geometry only)")
       ->check(InRange(0.0, 1000.0))
+      ->capture_default_str();
+  sub->add_option("--max-pose-gap", o->max_pose_gap_s,
+                  "Ground truth: do not interpolate a frame's pose across a gap longer than this "
+                  "(s); such frames are skipped")
+      ->check(Positive())
       ->capture_default_str();
   sub->add_option("--trajectory", o->trajectory_path,
                   "Write the poses used (TUM format: t tx ty tz qx qy qz qw)")
