@@ -1,5 +1,6 @@
 #include "fusion/mesh_block.h"
 
+#include <Eigen/Geometry>
 #include <algorithm>
 #include <cmath>
 
