@@ -39,7 +39,7 @@ constexpr int kCornerOffset[8] = {0,
                                   kGrid* kGrid + 1,
                                   kGrid* kGrid + kGrid,
                                   kGrid* kGrid + kGrid + 1};
-constexpr int kAxisStep[3] = {1, kGrid, kGrid * kGrid};
+constexpr int kAxisStep[3] = {1, kGrid, kGrid* kGrid};
 
 // Fills the grid; false when no surface can pass through it (no observed voxel inside or
 // none outside), the common case that then costs no cube visits.
@@ -172,13 +172,12 @@ struct BlockMesher {
     }
     std::array<uint8_t, 3> rgb;
     for (int k = 0; k < 3; ++k)  // t in [0, 1]: +0.5 and truncation round to nearest
-      rgb[k] = uint8_t(float(grid.rgb[a][k]) +
-                       t * (float(grid.rgb[b][k]) - float(grid.rgb[a][k])) + 0.5f);
+      rgb[k] = uint8_t(float(grid.rgb[a][k]) + t * (float(grid.rgb[b][k]) - float(grid.rgb[a][k])) +
+                       0.5f);
     // The four cubes around an edge reach into the previous block when a perpendicular
     // coordinate is 0, and the edge lies in the next block when one is 8.
     const int e1 = (axis + 1) % 3, e2 = (axis + 2) % 3;
-    const bool shared =
-        l[e1] == 0 || l[e1] == kBlockSide || l[e2] == 0 || l[e2] == kBlockSide;
+    const bool shared = l[e1] == 0 || l[e1] == kBlockSide || l[e2] == 0 || l[e2] == kBlockSide;
     return AddVertex(a * 4 + axis, VertexKey({g[0], g[1], g[2]}, axis), shared, p, rgb);
   }
 

@@ -10,8 +10,8 @@ namespace voxplan::internal {
 
 namespace {
 
-constexpr int kFloat = 5126, kUnsignedInt = 5125;                   // accessor componentType
-constexpr int kArrayBuffer = 34962, kElementArrayBuffer = 34963;    // bufferView target
+constexpr int kFloat = 5126, kUnsignedInt = 5125;                 // accessor componentType
+constexpr int kArrayBuffer = 34962, kElementArrayBuffer = 34963;  // bufferView target
 constexpr uint32_t kMagic = 0x46546C67, kJsonChunk = 0x4E4F534A, kBinChunk = 0x004E4942;
 
 void AppendU32(std::string& out, uint32_t v) {
@@ -65,9 +65,9 @@ Result<std::string> EncodeGlb(const Mesh& mesh) {
                          {"accessors", nlohmann::json::array()}};
   std::string bin;
   nlohmann::json attributes;
-  attributes["POSITION"] = AddAccessor(
-      gltf, bin, n, 12, kFloat, "VEC3", kArrayBuffer,
-      Vec3Filler(n, [&](size_t i, int k) { return mesh.positions[i][k]; }));
+  attributes["POSITION"] =
+      AddAccessor(gltf, bin, n, 12, kFloat, "VEC3", kArrayBuffer,
+                  Vec3Filler(n, [&](size_t i, int k) { return mesh.positions[i][k]; }));
   Eigen::Vector3f lo = mesh.positions[0], hi = mesh.positions[0];  // glTF requires the bounds
   for (const auto& p : mesh.positions) {
     lo = lo.cwiseMin(p);
@@ -76,9 +76,9 @@ Result<std::string> EncodeGlb(const Mesh& mesh) {
   gltf["accessors"][0]["min"] = {lo.x(), lo.y(), lo.z()};
   gltf["accessors"][0]["max"] = {hi.x(), hi.y(), hi.z()};
   if (!mesh.normals.empty())
-    attributes["NORMAL"] = AddAccessor(
-        gltf, bin, n, 12, kFloat, "VEC3", kArrayBuffer,
-        Vec3Filler(n, [&](size_t i, int k) { return mesh.normals[i][k]; }));
+    attributes["NORMAL"] =
+        AddAccessor(gltf, bin, n, 12, kFloat, "VEC3", kArrayBuffer,
+                    Vec3Filler(n, [&](size_t i, int k) { return mesh.normals[i][k]; }));
   if (!mesh.colors.empty())
     attributes["COLOR_0"] = AddAccessor(
         gltf, bin, n, 12, kFloat, "VEC3", kArrayBuffer,

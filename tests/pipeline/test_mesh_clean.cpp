@@ -35,8 +35,8 @@ Defects CountDefects(const Mesh& mesh) {
   for (const auto& t : mesh.triangles) {
     for (uint32_t v : t) used[v] = 1;
     const Eigen::Vector3d p0 = mesh.positions[t[0]].cast<double>();
-    const Eigen::Vector3d n = (mesh.positions[t[1]].cast<double>() - p0)
-                                  .cross(mesh.positions[t[2]].cast<double>() - p0);
+    const Eigen::Vector3d n =
+        (mesh.positions[t[1]].cast<double>() - p0).cross(mesh.positions[t[2]].cast<double>() - p0);
     d.zero_area += t[0] == t[1] || t[1] == t[2] || t[0] == t[2] || n.isZero(0.0);
   }
   d.unused_vertices = size_t(std::count(used.begin(), used.end(), uint8_t{0}));
@@ -89,8 +89,8 @@ float OctahedronField(const Eigen::Vector3f& p) { return (p - kCentre).lpNorm<1>
 
 TsdfVolume OctahedronVolume() {
   const Eigen::Vector3f reach = Eigen::Vector3f::Constant(kRadius + 4 * kVoxel);
-  return test::FillExactSdf(OctahedronField, {kVoxel, 4 * kVoxel}, kCentre - reach,
-                            kCentre + reach, /*all_blocks=*/true);
+  return test::FillExactSdf(OctahedronField, {kVoxel, 4 * kVoxel}, kCentre - reach, kCentre + reach,
+                            /*all_blocks=*/true);
 }
 
 TEST(CleanMesh, ExactZeroCornersGiveOneVertexAndNoZeroAreaTriangle) {
