@@ -1,7 +1,9 @@
 #pragma once
 // Marching cubes over the hashed volume: per block, with neighbour lookups across block borders,
-// vertices welded by the voxel edge they lie on, per-vertex colour and normals; parallel over
-// blocks and deterministic (same volume -> same mesh bytes, whatever the thread count).
+// vertices welded by the voxel edge or corner they lie on, per-vertex colour and normals;
+// parallel over blocks and deterministic (same volume -> same mesh bytes, whatever the thread
+// count). The mesh has no zero-area triangle, no two vertices at one position and no vertex
+// that no triangle uses (fusion/README.md).
 #include <map>
 #include <memory>
 #include <vector>

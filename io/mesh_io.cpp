@@ -16,6 +16,7 @@
 
 #include "io/assimp_material.h"
 #include "io/file_util.h"
+#include "io/mesh_encode.h"
 
 namespace voxplan {
 
@@ -141,27 +142,27 @@ Status CheckMesh(const Mesh& mesh) {
 
 Status WriteMesh(const Mesh& mesh, const std::string& path) {
   const std::string ext = LowerExtension(path);
-  const char* format = nullptr;
-  if (ext == ".obj") {
-    format = "objnomtl";  // one file: the .mtl of "obj" would be named after the temp file
-  } else if (ext == ".glb") {
-    format = "glb2";
-  } else if (ext == ".stl") {
-    format = "stlb";
-  } else if (ext != ".ply") {
+  if (ext != ".ply" && ext != ".obj" && ext != ".glb" && ext != ".stl")
     return InvalidArgument("cannot write mesh " + path + ": unsupported extension '" + ext +
                            "' (use .ply, .obj, .glb or .stl)");
-  }
   VOXPLAN_RETURN_IF_ERROR(CheckMesh(mesh).WithContext("cannot write mesh " + path));
 
+  // PLY, OBJ and GLB are encoded here (io/mesh_encode.h): assimp's OBJ and glTF exporters join
+  // identical vertices. Its binary STL exporter writes every triangle's own corners as given.
   std::string bytes;
-  if (!format) {
+  if (ext == ".ply") {
     bytes = EncodePly(mesh);
+  } else if (ext == ".obj") {
+    bytes = internal::EncodeObj(mesh);
+  } else if (ext == ".glb") {
+    Result<std::string> glb = internal::EncodeGlb(mesh);
+    if (!glb.ok()) return glb.status().WithContext("cannot write mesh " + path);
+    bytes = std::move(*glb);
   } else {
     // Export to memory, then write the bytes ourselves so the atomic rename covers them.
     const std::unique_ptr<aiScene> scene = MakeScene(mesh);
     Assimp::Exporter exporter;
-    const aiExportDataBlob* blob = exporter.ExportToBlob(scene.get(), format);
+    const aiExportDataBlob* blob = exporter.ExportToBlob(scene.get(), "stlb");
     if (!blob)
       return IoError("cannot write mesh " + path + ": assimp: " + exporter.GetErrorString());
     if (blob->next)
