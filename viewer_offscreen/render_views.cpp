@@ -14,7 +14,8 @@ namespace voxplan {
 Status RenderViewsParams::Validate() const {
   VOXPLAN_RETURN_IF_ERROR(bounds::CheckImageSize("render size", width, height));
   VOXPLAN_RETURN_IF_ERROR(bounds::CheckRange("field of view", fov_deg, 1.0, 179.0, "degrees"));
-  VOXPLAN_RETURN_IF_ERROR(bounds::CheckRange("orbit views", orbit_views, 1, 3600));
+  // 0 renders one view, as 1 does (the CLI's default when neither --orbit nor --pose is given).
+  VOXPLAN_RETURN_IF_ERROR(bounds::CheckRange("orbit views", orbit_views, 0, 3600));
   VOXPLAN_RETURN_IF_ERROR(
       bounds::CheckRange("orbit elevation", orbit_elevation_deg, -90.0, 90.0, "degrees"));
   if (orbit_radius_m)

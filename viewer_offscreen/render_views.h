@@ -22,13 +22,13 @@ struct RenderViewsParams {
   ShadeMode mode = ShadeMode::kShaded;
   // One view from here (its depth colour range from the image); unset: an orbit.
   std::optional<Pose3f> T_W_C;
-  int orbit_views = 1;  // at least one
+  int orbit_views = 1;  // 0 renders one view too
   Eigen::Vector3f up_W = Eigen::Vector3f::UnitZ();
   std::optional<float> orbit_radius_m;  // across the up axis; unset: framed on the bounds
   std::optional<float> orbit_height_m;  // along the up axis; unset: framed on the bounds
   float orbit_elevation_deg = 35.0f;    // of the framing
 
-  // Image size within core/bounds.h's, field of view in [1, 179] degrees, 1 to 3600 orbit
+  // Image size within core/bounds.h's, field of view in [1, 179] degrees, 0 to 3600 orbit
   // views, finite orbit numbers and pose; InvalidArgument naming the value otherwise.
   Status Validate() const;
   // Polled before every view: true ends the rendering there with a kCancelled status.

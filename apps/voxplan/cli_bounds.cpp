@@ -3,9 +3,10 @@
 #include <unistd.h>
 
 #include <algorithm>
-#include <cmath>
 #include <cctype>
+#include <cmath>
 #include <fstream>
+#include <sstream>
 
 #include "core/bounds.h"
 
@@ -19,7 +20,13 @@ std::string TypeName(double lo, double hi, const std::string& unit) {
 
 // Integers in full: "[0, 1073741824]", not "1.07374e+09".
 std::string IntRangeText(int64_t lo, int64_t hi, const std::string& unit) {
-  return "[" + std::to_string(lo) + ", " + std::to_string(hi) + "]" + (unit.empty() ? "" : " " + unit);
+  std::string text = "[";  // appended: GCC 12 warns (-Wrestrict, falsely) on "[" + std::string
+  text += std::to_string(lo);
+  text += ", ";
+  text += std::to_string(hi);
+  text += "]";
+  if (!unit.empty()) text += " " + unit;
+  return text;
 }
 
 }  // namespace
@@ -50,9 +57,7 @@ CLI::Validator IntInRange(int64_t lo, int64_t hi, const std::string& unit) {
 }
 
 CLI::Validator ThreadCount() { return IntInRange(0, bounds::kThreadsMax, "(0: all)"); }
-CLI::Validator VoxelSize() {
-  return InRange(bounds::kVoxelSizeMinM, bounds::kVoxelSizeMaxM, "m");
-}
+CLI::Validator VoxelSize() { return InRange(bounds::kVoxelSizeMinM, bounds::kVoxelSizeMaxM, "m"); }
 CLI::Validator FrameCount() { return IntInRange(0, bounds::kFramesMax, "(0: all)"); }
 CLI::Validator Stride() { return IntInRange(1, bounds::kFramesMax); }
 CLI::Validator ImageSide() { return IntInRange(1, bounds::kImageSideMax, "pixels"); }
@@ -61,13 +66,13 @@ std::string CheckVoxelAndTrunc(double voxel_size_m, double trunc_m,
                                const std::string& trunc_option) {
   const double voxels = trunc_m / voxel_size_m;
   if (voxels >= bounds::kTruncMinVoxels && voxels <= bounds::kTruncMaxVoxels) return {};
-  return trunc_option + " must be " + bounds::RangeText(bounds::kTruncMinVoxels,
-                                                        bounds::kTruncMaxVoxels, "voxels") +
-         " = " +
-         bounds::RangeText(bounds::kTruncMinVoxels * voxel_size_m,
-                           bounds::kTruncMaxVoxels * voxel_size_m, "m") +
-         " at --voxel-size " + std::to_string(voxel_size_m) + ", got " + std::to_string(trunc_m) +
-         " m";
+  std::ostringstream message;
+  message << trunc_option << " must be in "
+          << bounds::RangeText(bounds::kTruncMinVoxels, bounds::kTruncMaxVoxels, "voxels") << " ("
+          << bounds::RangeText(bounds::kTruncMinVoxels * voxel_size_m,
+                               bounds::kTruncMaxVoxels * voxel_size_m, "m")
+          << " at --voxel-size " << voxel_size_m << "), got " << trunc_m << " m";
+  return message.str();
 }
 
 void AddMemoryBudgetOptions(CLI::App* sub, MemoryBudgetOptions& o, bool with_on_limit) {
@@ -88,8 +93,11 @@ void AddMemoryBudgetOptions(CLI::App* sub, MemoryBudgetOptions& o, bool with_on_
 }
 
 Result<uint64_t> ParseMemorySize(const std::string& text) {
-  const std::string range = "[" + std::to_string(bounds::kMemoryMinBytes >> 20) + "M, " +
-                            std::to_string(bounds::kMemoryMaxBytes >> 40) + "T]";
+  std::string range = "[";  // appended: GCC 12 warns (-Wrestrict, falsely) on "[" + std::string
+  range += std::to_string(bounds::kMemoryMinBytes >> 20);
+  range += "M, ";
+  range += std::to_string(bounds::kMemoryMaxBytes >> 40);
+  range += "T]";
   size_t used = 0;
   double value = 0.0;
   try {

@@ -9,6 +9,7 @@
 #include <sstream>
 
 #include "apps/voxplan/cli_common.h"
+#include "core/bounds.h"
 #include "apps/voxplan/path_check.h"
 #include "apps/voxplan/signals.h"
 #include "core/parallel.h"
@@ -70,9 +71,9 @@ int CheckUsage(const ExploreOptions& o, std::vector<Eigen::Vector2f>* starts) {
     return Fail("--fov-deg must lie strictly between " + Num(kMinFovDeg) + " and " +
                     Num(kMaxFovDeg) + " degrees, got " + Num(o.fov_deg),
                 kExitUsage);
-  if (!(o.max_range_m > kMinRangeM && std::isfinite(o.max_range_m)))
+  if (!(o.max_range_m > kMinRangeM && o.max_range_m <= bounds::kDepthMaxM))
     return Fail("--max-range-m must be a finite number of metres above " + Num(kMinRangeM) +
-                    ", got " + Num(o.max_range_m),
+                    " and at most " + Num(bounds::kDepthMaxM) + ", got " + Num(o.max_range_m),
                 kExitUsage);
   std::error_code ec;
   const fs::path out(o.run.out_dir);

@@ -51,7 +51,7 @@ Result<std::pair<int, int>> ParseSize(const std::string& text) {
   if (!(in >> width >> x >> height) || (x != 'x' && x != 'X') || (in >> extra)) {
     return InvalidArgument("--size wants WxH, e.g. 640x480: " + text);
   }
-  VOXPLAN_RETURN_IF_ERROR(bounds::CheckImageSize("--size", width, height));
+  VOXPLAN_RETURN_IF_ERROR(bounds::CheckImageSize("image size", width, height));
   return std::pair(width, height);
 }
 

@@ -91,7 +91,8 @@ TEST(VolumeBudget, PastTheBudgetNoNewBlockAndMemoryStaysWithin) {
 
 TEST(VolumeBudget, NoBudgetMeansNoLimit) {
   TsdfVolume volume(VolumeParams{0.01f, 0.04f});
-  for (int x = 0; x < 600; ++x) ASSERT_NE(volume.AllocateWithinBudget(BlockIndex{x, 0, 0}), nullptr);
+  for (int x = 0; x < 600; ++x)
+    ASSERT_NE(volume.AllocateWithinBudget(BlockIndex{x, 0, 0}), nullptr);
   EXPECT_EQ(volume.blocks_refused(), 0u);
 }
 

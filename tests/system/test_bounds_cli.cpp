@@ -68,8 +68,8 @@ TEST(BoundsCliTest, IntrinsicsAgainstTheImageSize) {
   // The same from a dataset's camera file: a 7-Scenes folder whose camera-intrinsics.txt says
   // fx = fy = 1 (its frames linked from the shared data).
   const test::TempDir dir("voxplan-bounds-camera");
-  for (const char* name : {"frame-000000.depth.png", "frame-000000.color.jpg",
-                           "frame-000000.pose.txt"})
+  for (const char* name :
+       {"frame-000000.depth.png", "frame-000000.color.jpg", "frame-000000.pose.txt"})
     fs::create_symlink(KitchenDir() / name, dir / name);
   std::ofstream(dir / "camera-intrinsics.txt") << "1 0 320\n0 1 240\n0 0 1\n";
   ExpectRefused({"fuse", dir.path().string()}, {"camera-intrinsics.txt", "|fx|", "[64, 64000]"});
@@ -86,11 +86,10 @@ TEST(BoundsCliTest, RenderSizesAndNaN) {
                 {"--orbit-height", "[-10000, 10000] m"});
   ExpectRefused({"render", mesh, "--orbit-radius", "inf", "--out", out}, {"--orbit-radius"});
   ExpectRefused({"render", mesh, "--near", "nan", "--out", out}, {"--near"});
-  ExpectRefused({"explore", "--scene", "apartment", "--planner", "greedy", "--out", out,
-                 "--width", "100000"},
-                {"--width", "[1, 16384] pixels"});
-  ExpectRefused({"sim", "render", "--scene", mesh, "--trajectory", mesh, "--out", out, "--fx",
-                 "1"},
+  ExpectRefused(
+      {"explore", "--scene", "apartment", "--planner", "greedy", "--out", out, "--width", "100000"},
+      {"--width", "[1, 16384] pixels"});
+  ExpectRefused({"sim", "render", "--scene", mesh, "--trajectory", mesh, "--out", out, "--fx", "1"},
                 {"--fx", "|fx|"});
 }
 
@@ -103,9 +102,13 @@ TEST(BoundsCliTest, MemorySizes) {
 
 // ICL-NUIM at 5 mm: 20 frames need far more than 16 MiB of blocks.
 std::vector<std::string> TightFuse(const fs::path& stats) {
-  return {"fuse",         IclDir().string(), "--frames",  "20",          "--voxel-size",
-          "0.005",        "--trunc",         "0.02",      "--threads",   "2",
-          "--max-memory", "16M",             "--stats",   stats.string()};
+  return {"fuse",         IclDir().string(),
+          "--frames",     "20",
+          "--voxel-size", "0.005",
+          "--trunc",      "0.02",
+          "--threads",    "2",
+          "--max-memory", "16M",
+          "--stats",      stats.string()};
 }
 
 TEST(BoundsCliTest, MemoryBudgetDropsBlocksAndCountsThem) {

@@ -156,7 +156,7 @@ TEST(RenderCliTest, RefusesBadArgumentsAndWritesNothing) {
   WriteCubeMesh(mesh);
   const std::vector<std::vector<std::string>> usage = {
       {"--mode", "wireframe"},   {"--size", "0x10"},
-      {"--size", "9000x100"},    {"--size", "-4x10"},
+      {"--size", "20000x100"},   {"--size", "-4x10"},
       {"--size", "640by480"},    {"--fov-deg", "0"},
       {"--orbit", "0"},          {"--orbit", "2", "--pose", "0 0 0 0 0 0 1"},
       {"--pose", "0 0 0 0 0 0"}, {"--pose", "0 0 0 0 0 0 5"},
