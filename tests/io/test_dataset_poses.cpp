@@ -53,6 +53,12 @@ std::unique_ptr<Dataset> OpenOk(const fs::path& path, const DatasetOptions& opti
   return ds.ok() ? std::move(ds).value() : nullptr;
 }
 
+DatasetOptions Format(DatasetFormat format) {
+  DatasetOptions options;
+  options.format = format;
+  return options;
+}
+
 // A Redwood trajectory.log whose pose k is a translation of (k, 0, 0), for frames `ids`.
 std::string RedwoodLog(const std::vector<int>& ids) {
   std::string log;
@@ -83,7 +89,7 @@ TEST(DatasetPoses, RedwoodMissingFrameKeepsLaterPosesRight) {
     }
     if (with_match) WriteText(dir / "rgbd.match", match);
     WriteText(dir / "trajectory.log", RedwoodLog({0, 1, 2, 3, 4}));
-    auto ds = OpenOk(dir.path(), {.format = DatasetFormat::kRedwood});
+    auto ds = OpenOk(dir.path(), Format(DatasetFormat::kRedwood));
     ASSERT_TRUE(ds);
     ASSERT_EQ(ds->info().num_frames, 4u);
     EXPECT_EQ(PoseX(*ds, 1), 1.0);
@@ -103,7 +109,7 @@ TEST(DatasetPoses, RedwoodUnpaddedNamesSortNumerically) {
     ids.push_back(k);
   }
   WriteText(dir / "trajectory.log", RedwoodLog(ids));
-  auto ds = OpenOk(dir.path(), {.format = DatasetFormat::kRedwood});
+  auto ds = OpenOk(dir.path(), Format(DatasetFormat::kRedwood));
   ASSERT_TRUE(ds);
   ASSERT_EQ(ds->info().num_frames, 12u);
   for (size_t i = 0; i < 12; ++i) {
@@ -176,7 +182,7 @@ TEST(DatasetPoses, LongerOrShorterPoseListsAreWarnedWithBothCounts) {
               "1 depth/1.png 1 depth/1.png\n2 depth/2.png 2 depth/2.png\n");
     WriteText(dir / "traj0.gt.freiburg",
               "1 0 0 0 0 0 0 1\n2 0 0 0 0 0 0 1\n3 0 0 0 0 0 0 1\n4 0 0 0 0 0 0 1\n");
-    auto ds = OpenOk(dir.path(), {.format = DatasetFormat::kIclNuim});
+    auto ds = OpenOk(dir.path(), Format(DatasetFormat::kIclNuim));
     ASSERT_TRUE(ds);
     EXPECT_FLOAT_EQ(ds->info().camera.fy, -480.f);  // the format's own convention stays
     EXPECT_TRUE(AnyWarning(ds->info(), "4 poses for 2 frames; 2 poses match no frame"))
@@ -187,7 +193,7 @@ TEST(DatasetPoses, LongerOrShorterPoseListsAreWarnedWithBothCounts) {
     test::TempDir dir("redwood");
     for (int k = 0; k < 4; ++k) WriteDepth(dir / ("depth/" + std::to_string(k) + ".png"));
     WriteText(dir / "trajectory.log", RedwoodLog({0, 1}));
-    auto ds = OpenOk(dir.path(), {.format = DatasetFormat::kRedwood});
+    auto ds = OpenOk(dir.path(), Format(DatasetFormat::kRedwood));
     ASSERT_TRUE(ds);
     EXPECT_TRUE(AnyWarning(ds->info(), "2 poses for 4 frames; 2 frames have no pose"))
         << Warnings(ds->info());
