@@ -76,7 +76,7 @@ void SetMatrixPose(const Eigen::Matrix4d& m, const std::string& where, Entry& e,
 // Rows of 4 numbers starting at lines[first]; errors name the first offending line.
 Result<Eigen::Matrix4d> ParseMatrixRows(const TextFile& f, size_t first);
 // Refuses focal lengths read from `file` that are not positive and finite, as file:line.
-// (ICL-NUIM's negative fy is the format's convention, a built-in default no file states.)
+// (ICL-NUIM's negative fy is that format's built-in default; camera.txt passes |fy|.)
 Status CheckFocalLengths(double fx, double fy, const std::string& file, int line);
 // The 1-based line of the first occurrence of `text` in `path` (for JSON values), else 0.
 int LineOf(const std::string& path, const std::string& text);

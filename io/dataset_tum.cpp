@@ -122,7 +122,9 @@ Result<Draft> ReadTum(const fs::path& root, double max_pose_gap_s) {
     VOXPLAN_RETURN_IF_ERROR(ParseNumbers(*file, line, 0, 4, k));
     for (double v : k)
       if (!std::isfinite(v)) return LineError(camera_txt, line.number, "intrinsics must be finite");
-    VOXPLAN_RETURN_IF_ERROR(CheckFocalLengths(k[0], k[1], camera_txt, line.number));
+    // A negative fy is a y-flipped camera (ICL-NUIM's convention), which `voxplan sim render
+    // --fy` writes here; zero, or a negative fx, is no camera.
+    VOXPLAN_RETURN_IF_ERROR(CheckFocalLengths(k[0], std::abs(k[1]), camera_txt, line.number));
     const float kf[4] = {float(k[0]), float(k[1]), float(k[2]), float(k[3])};
     SetIntrinsics(d, kf);
     d.intrinsics_source = camera_txt;

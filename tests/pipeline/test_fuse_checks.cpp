@@ -63,14 +63,14 @@ Frame Translated(double x) {
   return WithPose(T);
 }
 
-struct Run {
+struct FuseRun {
   FuseReport report;
   std::vector<std::string> warnings;
 };
 
-Run Fuse(const Dataset& dataset, const FuseParams& params = {}) {
+FuseRun Fuse(const Dataset& dataset, const FuseParams& params = {}) {
   TsdfVolume volume(kVolume);
-  Run run;
+  FuseRun run;
   FuseObserver observer;
   observer.warning = [&](const std::string& w) { run.warnings.push_back(w); };
   std::vector<size_t> all(dataset.info().num_frames);
@@ -93,7 +93,7 @@ TEST(FuseChecks, AbsurdOrNonFinitePoseIsSkippedAndCounted) {
   nan_pose.translation().y() = std::numeric_limits<double>::quiet_NaN();
   const PosedRoom room({WithPose(RoomPose().cast<double>()), Translated(1e6), WithPose(nan_pose),
                         WithPose(RoomPose().cast<double>())});
-  const Run run = Fuse(room);
+  const FuseRun run = Fuse(room);
   EXPECT_EQ(run.report.frames.size(), 2u);
   EXPECT_EQ(run.report.skipped_bad_pose, 2u);
   EXPECT_EQ(run.report.skipped_no_pose, 0u);
@@ -110,7 +110,7 @@ TEST(FuseChecks, PoseWhoseViewLeavesTheBlockIndexRangeIsAlwaysSkipped) {
   params.max_pose_translation_m = 1e12;  // no bound of its own: the index range still holds
   // 2^20 blocks of 8 voxels of 2 cm: about 168 km.
   const PosedRoom room({Translated(1.6e5), Translated(1.7e5), WithPose(RoomPose().cast<double>())});
-  const Run run = Fuse(room, params);
+  const FuseRun run = Fuse(room, params);
   EXPECT_EQ(run.report.frames.size(), 2u);
   EXPECT_EQ(run.report.skipped_bad_pose, 1u);
   EXPECT_TRUE(AnyContains(run.warnings,
@@ -125,7 +125,7 @@ TEST(FuseChecks, PosesTheReaderRejectedAreCountedByReason) {
   gap.pose_rejected = PoseRejection::kGroundTruthGap;
   gap.pose_rejected_why = "depth.txt:7: depth 3.5 lies in a 2 s gap of groundtruth.txt";
   const PosedRoom room({WithPose(RoomPose().cast<double>()), bad, gap, Frame{}});
-  const Run run = Fuse(room);
+  const FuseRun run = Fuse(room);
   EXPECT_EQ(run.report.frames.size(), 1u);
   EXPECT_EQ(run.report.skipped_bad_pose, 1u);
   EXPECT_EQ(run.report.skipped_pose_gap, 1u);
@@ -155,7 +155,7 @@ TEST(FuseChecks, WrongDepthScaleIsWarnedWithTheLikelyScale) {
   as_metres.intrinsics = PinholeCamera{0, 0, 12.f, 12.f, 7.5f, 5.5f};
   auto wrong = OpenDataset(dir.path().string(), as_metres);
   ASSERT_TRUE(wrong.ok()) << wrong.status().message();
-  const Run run = Fuse(**wrong);
+  const FuseRun run = Fuse(**wrong);
   EXPECT_DOUBLE_EQ(run.report.first_frames_median_depth_m, 1500.0);
   EXPECT_EQ(run.report.suggested_depth_scale, 1000.0);
   EXPECT_TRUE(AnyContains(run.warnings, dir.path().string() + ": the median valid depth of the "
@@ -168,7 +168,7 @@ TEST(FuseChecks, WrongDepthScaleIsWarnedWithTheLikelyScale) {
   right.depth_scale.reset();  // Redwood's own 1000
   auto ok = OpenDataset(dir.path().string(), right);
   ASSERT_TRUE(ok.ok()) << ok.status().message();
-  const Run good = Fuse(**ok);
+  const FuseRun good = Fuse(**ok);
   EXPECT_DOUBLE_EQ(good.report.first_frames_median_depth_m, 1.5);
   EXPECT_EQ(good.report.suggested_depth_scale, 0.0);
   EXPECT_FALSE(AnyContains(good.warnings, "median valid depth"));
