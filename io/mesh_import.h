@@ -3,7 +3,7 @@
 // scene loader) both go through it; nothing else in voxplan reads a mesh file.
 //
 //  - .ply: voxplan's own reader (ply_reader.h), never assimp.
-//  - .obj .glb .stl (.dae for scenes): assimp, made safe: the importer is chosen by the extension
+//  - .obj .glb .stl .dae: assimp, made safe: the importer is chosen by the extension
 //    alone and every other importer is removed, so content never picks the format; files it
 //    opens besides the mesh (mtllib, textures, glTF buffers) must be regular files inside the
 //    mesh's own folder (symlinks resolved), anything else reads as missing; cheap structural
