@@ -89,7 +89,10 @@ class AsciiSource {
     double v = 0.0;
     const auto [p, ec] = std::from_chars(token.data(), token.data() + token.size(), v);
     if (ec != std::errc() || p != token.data() + token.size() || !FitsType(type, v)) {
-      error_ = "'" + std::string(token.substr(0, 40)) + "' is not a value of the declared type";
+      // Appended piecewise: GCC 12 warns falsely (-Wrestrict) on "'" + std::string(...).
+      error_.assign(1, '\'');
+      error_.append(token.substr(0, 40));
+      error_.append("' is not a value of the declared type");
       return false;
     }
     *value = v;

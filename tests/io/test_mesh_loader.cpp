@@ -47,7 +47,9 @@ void ExpectSameMesh(const Mesh& a, const Mesh& b) {
   ASSERT_EQ(a.normals.size(), b.normals.size());
   for (size_t v = 0; v < a.num_vertices(); ++v) {
     EXPECT_TRUE(a.positions[v].isApprox(b.positions[v], 1e-6f)) << "vertex " << v;
-    if (!a.normals.empty()) EXPECT_TRUE(a.normals[v].isApprox(b.normals[v], 1e-6f));
+    if (!a.normals.empty()) {
+      EXPECT_TRUE(a.normals[v].isApprox(b.normals[v], 1e-6f));
+    }
   }
 }
 
