@@ -38,10 +38,11 @@ void WriteBadPly(const fs::path& path, const std::string& face_count_line,
 TEST(MeshLoaderCli, EveryMeshReadingCommandRefusesAMalformedMesh) {
   test::TempDir dir("mesh_loader_cli");
   const fs::path oob = dir / "out_of_range.ply";
-  WriteBadPly(oob, "element face 1\n", "\x03" + Le32(0) + Le32(1) + Le32(70000000));
+  WriteBadPly(oob, "element face 1\n", std::string(1, 3) + Le32(0) + Le32(1) + Le32(70000000));
   const fs::path cut = dir / "truncated.ply";
   WriteBadPly(cut, "element face 2\n",
-              "\x04" + Le32(0) + Le32(1) + Le32(2) + Le32(0) + "\x03" + Le32(0) + Le32(1));
+              std::string(1, 4) + Le32(0) + Le32(1) + Le32(2) + Le32(0) + std::string(1, 3) +
+                  Le32(0) + Le32(1));
   struct Case {
     fs::path mesh;
     const char* reason;
