@@ -29,11 +29,6 @@ std::string LowerExtension(const std::string& path) {
   return ext;
 }
 
-uint8_t ToByte(float c) {
-  if (!std::isfinite(c)) return 0;
-  return uint8_t(std::lround(std::clamp(c, 0.0f, 1.0f) * 255.0f));
-}
-
 // Binary little-endian PLY written directly: assimp's PLY exporter stores colours as floats
 // (r, g, b, a), which most tools read as non-standard properties; uchar red/green/blue is what
 // MeshLab, Open3D and assimp itself expect.
@@ -177,97 +172,5 @@ bool IsSupportedMeshExtension(const std::string& path) {
   const std::string ext = LowerExtension(path);
   return ext == ".ply" || ext == ".obj" || ext == ".glb" || ext == ".stl";
 }
-
-Result<Mesh> ReadMesh(const std::string& path, const MeshReadOptions& options) {
-  if (!(std::isfinite(options.scale) && options.scale > 0.0f))
-    return InvalidArgument("reading " + path + ": scale must be positive, got " +
-                           std::to_string(options.scale));
-  std::error_code ec;
-  if (!std::filesystem::is_regular_file(path, ec)) return NotFound("no such mesh file: " + path);
-
-  Assimp::Importer importer;
-  // Points and lines are split into meshes of their own (SortByPType) and skipped below.
-  importer.SetPropertyInteger(AI_CONFIG_PP_SBP_REMOVE,
-                              aiPrimitiveType_POINT | aiPrimitiveType_LINE);
-  const aiScene* scene =
-      importer.ReadFile(path, aiProcess_Triangulate | aiProcess_JoinIdenticalVertices |
-                                  aiProcess_PreTransformVertices | aiProcess_SortByPType);
-  if (!scene) return IoError("cannot read mesh " + path + ": " + importer.GetErrorString());
-
-  const std::string ext = LowerExtension(path);
-  const bool format_has_materials = ext != ".ply" && ext != ".stl";
-  // Colours and normals are kept only if every triangle mesh can supply them, so the merged
-  // arrays stay one per vertex.
-  bool any_color = false, all_normals = true, any_triangles = false;
-  for (unsigned int m = 0; m < scene->mNumMeshes; ++m) {
-    const aiMesh& mesh = *scene->mMeshes[m];
-    if (!(mesh.mPrimitiveTypes & aiPrimitiveType_TRIANGLE) || mesh.mNumFaces == 0) continue;
-    any_triangles = true;
-    aiColor4D c;
-    if (mesh.HasVertexColors(0) ||
-        internal::MaterialDiffuse(*scene, mesh.mMaterialIndex, format_has_materials, &c))
-      any_color = true;
-    if (!mesh.HasNormals()) all_normals = false;
-  }
-  if (!any_triangles) return InvalidArgument("mesh file " + path + " holds no triangles");
-
-  Mesh out;
-  const float s = options.scale;
-  auto orient = [&](const aiVector3D& v, float k) -> Eigen::Vector3f {
-    if (options.up == UpAxis::kY) return {k * v.x, -k * v.z, k * v.y};
-    return {k * v.x, k * v.y, k * v.z};
-  };
-  for (unsigned int m = 0; m < scene->mNumMeshes; ++m) {
-    const aiMesh& mesh = *scene->mMeshes[m];
-    if (!(mesh.mPrimitiveTypes & aiPrimitiveType_TRIANGLE) || mesh.mNumFaces == 0) continue;
-    const size_t base = out.positions.size();
-    if (base + mesh.mNumVertices > size_t(UINT32_MAX))
-      return Unsupported("mesh " + path + " has more vertices than 32-bit indices can address");
-    for (unsigned int v = 0; v < mesh.mNumVertices; ++v)
-      out.positions.push_back(orient(mesh.mVertices[v], s));
-    if (all_normals) {
-      for (unsigned int v = 0; v < mesh.mNumVertices; ++v) {
-        Eigen::Vector3f n = orient(mesh.mNormals[v], 1.0f);
-        const float len = n.norm();
-        out.normals.push_back(len > 0.0f && std::isfinite(len) ? Eigen::Vector3f(n / len)
-                                                               : Eigen::Vector3f::UnitZ());
-      }
-    }
-    if (any_color) {
-      aiColor4D diffuse(0.6f, 0.6f, 0.6f, 1.0f);  // assimp's own default grey
-      const bool has_vertex_colors = mesh.HasVertexColors(0);
-      if (!has_vertex_colors)
-        internal::MaterialDiffuse(*scene, mesh.mMaterialIndex, format_has_materials, &diffuse);
-      for (unsigned int v = 0; v < mesh.mNumVertices; ++v) {
-        const aiColor4D& c = has_vertex_colors ? mesh.mColors[0][v] : diffuse;
-        out.colors.push_back({ToByte(c.r), ToByte(c.g), ToByte(c.b)});
-      }
-    }
-    for (unsigned int f = 0; f < mesh.mNumFaces; ++f) {
-      const aiFace& face = mesh.mFaces[f];
-      if (face.mNumIndices != 3) continue;
-      out.triangles.push_back({uint32_t(base + face.mIndices[0]), uint32_t(base + face.mIndices[1]),
-                               uint32_t(base + face.mIndices[2])});
-    }
-  }
-  if (out.triangles.empty()) return InvalidArgument("mesh file " + path + " holds no triangles");
-  return out;
-}
-
-namespace internal {
-
-bool MaterialDiffuse(const aiScene& scene, unsigned int index, bool format_has_materials,
-                     aiColor4D* color) {
-  if (!format_has_materials) return false;
-  if (index >= scene.mNumMaterials || !scene.mMaterials[index]) return false;
-  const aiMaterial& material = *scene.mMaterials[index];
-  aiString name;
-  if (material.Get(AI_MATKEY_NAME, name) == AI_SUCCESS &&
-      std::strcmp(name.C_Str(), AI_DEFAULT_MATERIAL_NAME) == 0)
-    return false;
-  return material.Get(AI_MATKEY_COLOR_DIFFUSE, *color) == AI_SUCCESS;
-}
-
-}  // namespace internal
 
 }  // namespace voxplan

@@ -5,7 +5,6 @@
 #include <assimp/scene.h>
 
 #include <algorithm>
-#include <assimp/Importer.hpp>
 #include <cctype>
 #include <charconv>
 #include <cmath>
@@ -17,6 +16,7 @@
 #include <sstream>
 
 #include "io/assimp_material.h"
+#include "io/mesh_import.h"
 #include "sim/world_io.h"
 
 namespace voxplan {
@@ -314,6 +314,48 @@ void CollectNodes(const aiScene& scene, const aiNode& node, const aiMatrix4x4& p
     CollectNodes(scene, *node.mChildren[c], transform, out);
 }
 
+// The scene's mesh and its nodes (name, triangle count), in the world frame. Every format goes
+// through io's validating loader: PLY by ReadMesh (one node), the others by its confined assimp.
+struct ImportedMesh {
+  Mesh mesh;
+  std::vector<std::string> node_names;
+  std::vector<size_t> node_triangles;
+};
+
+Result<ImportedMesh> ImportSceneMesh(const std::string& path, const SceneLoadOptions& options) {
+  ImportedMesh out;
+  if (Lower(fs::path(path).extension().string()) == ".ply") {
+    Result<Mesh> mesh = ReadMesh(path, {options.scale, options.up});
+    if (!mesh.ok()) return mesh.status();
+    out.mesh = std::move(mesh.value());
+    out.node_names = {""};
+    out.node_triangles = {out.mesh.num_triangles()};
+    return out;
+  }
+  Result<internal::AssimpScene> imported = internal::ImportWithAssimp(
+      path, aiProcess_Triangulate | aiProcess_JoinIdenticalVertices | aiProcess_SortByPType);
+  if (!imported.ok()) return imported.status();
+  const aiScene& scene = *imported->scene;
+  const std::string ext = Lower(fs::path(path).extension().string());
+  MeshBuilder builder{scene, options, ext != ".stl", false, true, Mesh()};
+  builder.Survey();
+  std::vector<NodeMeshes> nodes;
+  CollectNodes(scene, *scene.mRootNode, aiMatrix4x4(), &nodes);
+  for (const NodeMeshes& node : nodes) {
+    size_t n = 0;
+    for (unsigned int m : node.meshes) {
+      Result<size_t> added = builder.Append(m, node.transform);
+      if (!added.ok()) return added.status().WithContext("scene " + path);
+      n += added.value();
+    }
+    out.node_names.push_back(node.name);
+    out.node_triangles.push_back(n);
+  }
+  out.mesh = std::move(builder.mesh);
+  VOXPLAN_RETURN_IF_ERROR(internal::CheckMeshGeometry(path, out.mesh));
+  return out;
+}
+
 std::string SiblingPath(const std::string& mesh_path, const std::string& suffix) {
   const fs::path p(mesh_path);
   return (p.parent_path() / (p.stem().string() + suffix)).string();
@@ -454,33 +496,13 @@ Result<World> LoadWorld(const std::string& path, const SceneLoadOptions& options
     table = std::move(read.value());
   }
 
-  Assimp::Importer importer;
-  importer.SetPropertyInteger(AI_CONFIG_PP_SBP_REMOVE,
-                              aiPrimitiveType_POINT | aiPrimitiveType_LINE);
-  const aiScene* scene = importer.ReadFile(
-      path, aiProcess_Triangulate | aiProcess_JoinIdenticalVertices | aiProcess_SortByPType);
-  if (!scene || !scene->mRootNode)
-    return IoError("cannot read scene " + path + ": " + importer.GetErrorString());
-  const std::string ext = Lower(fs::path(path).extension().string());
-  MeshBuilder builder{*scene, options, ext != ".ply" && ext != ".stl", false, true, Mesh()};
-  builder.Survey();
-  std::vector<NodeMeshes> nodes;
-  CollectNodes(*scene, *scene->mRootNode, aiMatrix4x4(), &nodes);
-
+  Result<ImportedMesh> imported = ImportSceneMesh(path, options);
+  if (!imported.ok()) return imported.status();
   World world;
   world.name = fs::path(path).stem().string();
-  std::vector<size_t> node_triangles;
-  for (const NodeMeshes& node : nodes) {
-    size_t n = 0;
-    for (unsigned int m : node.meshes) {
-      Result<size_t> added = builder.Append(m, node.transform);
-      if (!added.ok()) return added.status().WithContext("scene " + path);
-      n += added.value();
-    }
-    node_triangles.push_back(n);
-  }
-  world.mesh = std::move(builder.mesh);
-  if (world.mesh.triangles.empty()) return InvalidArgument("scene " + path + " holds no triangles");
+  world.mesh = std::move(imported->mesh);
+  const std::vector<std::string>& node_names = imported->node_names;
+  const std::vector<size_t>& node_triangles = imported->node_triangles;
 
   // Absurd scale: the scene's horizontal size must look like a building.
   Eigen::AlignedBox3f box;
@@ -525,13 +547,13 @@ Result<World> LoadWorld(const std::string& path, const SceneLoadOptions& options
       for (; t < num_tri; ++t) world.triangle_instance[t] = rest.id;
       world.instances.push_back(std::move(rest));
     }
-  } else if (nodes.size() > 1) {
+  } else if (node_names.size() > 1) {
     size_t t = 0;
-    for (size_t n = 0; n < nodes.size(); ++n) {
+    for (size_t n = 0; n < node_names.size(); ++n) {
       if (node_triangles[n] == 0) continue;
       Instance inst;
       inst.id = uint32_t(world.instances.size() + 1);
-      inst.model = nodes[n].name.empty() ? "node_" + std::to_string(n) : nodes[n].name;
+      inst.model = node_names[n].empty() ? "node_" + std::to_string(n) : node_names[n];
       std::string category;
       for (const FurnitureModel& m : index)
         if (m.model == StripAwsPrefix(inst.model)) category = m.category;
