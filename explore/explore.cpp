@@ -722,8 +722,8 @@ Result<ExploreResult> Explorer::Run(const std::vector<Eigen::Vector2f>& starts) 
   }
 
   result_.terminated = result_.planner_fault ? result_.planner_fault->Terminated()
-                       : done_                ? "done"
-                                              : "time_limit";
+                       : done_               ? "done"
+                                             : "time_limit";
   double t_end = t_s_;
   for (const RobotRun& r : robots_) t_end = std::max(t_end, r.t_s);
   result_.time_s = t_end;

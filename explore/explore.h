@@ -132,7 +132,7 @@ struct ExploreTimings {  // wall milliseconds, summed over the run
 };
 
 struct ExploreResult {
-  std::string terminated;  // "done", "time_limit", "planner_crashed" or "planner_hung"
+  std::string terminated;   // "done", "time_limit", "planner_crashed" or "planner_hung"
   std::string done_reason;  // "planner", "no_tasks" or "" (time limit)
   double time_s = 0.0;
   size_t frames_fused = 0;
@@ -143,7 +143,7 @@ struct ExploreResult {
   std::vector<RobotTrack> tracks;  // one per robot: r0, r1, ...
   std::vector<std::vector<PlannerTask>> task_views;  // per robot, views it reached, in order
   std::vector<PlanCallRecord> plan_calls;
-  std::vector<std::string> plan_log;  // rejections, failures and the plugin's messages
+  std::vector<std::string> plan_log;          // rejections, failures and the plugin's messages
   std::optional<PlannerFault> planner_fault;  // the call that ended the run, for planner_*
   std::vector<RunTimePoint> series;
   ExploreTimings timings;

@@ -130,10 +130,12 @@ int LoadPlannerOption(const ExploreOptions& o, std::unique_ptr<LoadedPlanner>* o
       return Fail("unknown planner '" + o.planner + "'; available: " + Join(available), kExitUsage);
   }
   PlannerFault fault;  // its call stays empty unless the plugin crashed or hung loading
-  Result<std::unique_ptr<LoadedPlanner>> planner = LoadPlanner(
-      o.planner,
-      {.config_json = config_json, .seed = o.run.explore.seed, .search_path = {}, .limits = o.limits},
-      &fault);
+  Result<std::unique_ptr<LoadedPlanner>> planner = LoadPlanner(o.planner,
+                                                               {.config_json = config_json,
+                                                                .seed = o.run.explore.seed,
+                                                                .search_path = {},
+                                                                .limits = o.limits},
+                                                               &fault);
   if (!planner.ok() && !fault.call.empty()) {
     Fail(planner.status().message() + "; nothing was run", kExitPlannerFault);
     ExitAfterPlannerFault();
@@ -198,9 +200,9 @@ int RunExploreCommand(const ExploreOptions& o) {
             << " plan calls -> " << run.out_dir << std::endl;
   PrintJsonLine(j);
   if (r.planner_fault) {
-    Fail(r.planner_fault->Describe(planner->name()) + "; the run ended at t=" +
-             Num(RoundTo(r.time_s, 1)) + " s with " + r.terminated + ", its outputs are in " +
-             run.out_dir,
+    Fail(r.planner_fault->Describe(planner->name()) +
+             "; the run ended at t=" + Num(RoundTo(r.time_s, 1)) + " s with " + r.terminated +
+             ", its outputs are in " + run.out_dir,
          kExitPlannerFault);
     ExitAfterPlannerFault();
   }

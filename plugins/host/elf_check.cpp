@@ -86,8 +86,8 @@ std::string CheckSegments(int fd, const Elf64_Ehdr& h, uint64_t size) {
     if (p.p_type != PT_LOAD) continue;
     if (p.p_offset > size || p.p_filesz > size - p.p_offset)
       return "loadable segment " + std::to_string(i) + " ends at byte " +
-             std::to_string(p.p_offset + p.p_filesz) + ", past the file's " +
-             std::to_string(size) + " (truncated?)";
+             std::to_string(p.p_offset + p.p_filesz) + ", past the file's " + std::to_string(size) +
+             " (truncated?)";
   }
   return "";
 }
@@ -100,9 +100,9 @@ std::string Check(const std::string& path) {
   if (!S_ISREG(st.st_mode)) return "not a regular file";
   const uint64_t size = uint64_t(st.st_size);
   Elf64_Ehdr h{};
-  if (size < EI_NIDENT || !ReadAt(file.fd, h.e_ident, EI_NIDENT, 0) || h.e_ident[EI_MAG0] != ELFMAG0 ||
-      h.e_ident[EI_MAG1] != ELFMAG1 || h.e_ident[EI_MAG2] != ELFMAG2 ||
-      h.e_ident[EI_MAG3] != ELFMAG3)
+  if (size < EI_NIDENT || !ReadAt(file.fd, h.e_ident, EI_NIDENT, 0) ||
+      h.e_ident[EI_MAG0] != ELFMAG0 || h.e_ident[EI_MAG1] != ELFMAG1 ||
+      h.e_ident[EI_MAG2] != ELFMAG2 || h.e_ident[EI_MAG3] != ELFMAG3)
     return "no ELF magic";
   if (h.e_ident[EI_CLASS] == ELFCLASS64 && size < sizeof h) return "ELF header truncated";
   if (h.e_ident[EI_CLASS] == ELFCLASS64 && !ReadAt(file.fd, &h, sizeof h, 0))

@@ -7,8 +7,8 @@
 #include <signal.h>
 
 #include <chrono>
-#include <exception>
 #include <condition_variable>
+#include <exception>
 #include <mutex>
 #include <string>
 #include <vector>

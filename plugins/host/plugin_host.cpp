@@ -2,17 +2,17 @@
 // symbol, a version handshake, refusal with a message instead of a crash).
 #include "plugins/host/plugin_host.h"
 
-#include "plugins/host/elf_check.h"
-#include "plugins/host/host_internal.h"
-#include "plugins/host/planner_thread.h"
-
 #include <dlfcn.h>
 
 #include <algorithm>
-#include <cstring>
 #include <cstdlib>
+#include <cstring>
 #include <set>
 #include <system_error>
+
+#include "plugins/host/elf_check.h"
+#include "plugins/host/host_internal.h"
+#include "plugins/host/planner_thread.h"
 
 #ifndef VOXPLAN_PLANNER_BUILD_DIR
 #define VOXPLAN_PLANNER_BUILD_DIR ""
@@ -112,8 +112,8 @@ Result<fs::path> FindPlanner(const std::string& name_or_path, const PlannerLoadO
       if (fs::exists(candidate)) return candidate;
     }
   }
-  return NotFound("unknown planner '" + name_or_path + "'; available: " +
-                  (available.empty() ? std::string("none") : Join(available)) +
+  return NotFound("unknown planner '" + name_or_path +
+                  "'; available: " + (available.empty() ? std::string("none") : Join(available)) +
                   " (set VOXPLAN_PLANNER_PATH or pass a path to a .so)");
 }
 
@@ -130,10 +130,11 @@ Status LoadedPlanner::Negotiate(vp_planner_entry_fn entry, const std::string& la
   vp_status* status_out = &status;
   PlannerFault where;
   where.call = "entry";
-  if (!Supervise([entry, out, status_out] {
-        *status_out = entry(VP_PLANNER_ABI_VERSION, &PlannerHostApi(), out);
-      },
-                 limits_.unbudgeted_s, where))
+  if (!Supervise(
+          [entry, out, status_out] {
+            *status_out = entry(VP_PLANNER_ABI_VERSION, &PlannerHostApi(), out);
+          },
+          limits_.unbudgeted_s, where))
     return Status(StatusCode::kInternal, fault_->Describe(label));
   if (api.abi_version == 0) {
     return Unsupported("plugin " + label + " did not report its planner ABI version (status " +
@@ -180,14 +181,12 @@ Status LoadedPlanner::Create(const PlannerLoadOptions& options, const std::strin
   const char* json = config->c_str();
   PlannerFault where;
   where.call = "create";
-  if (!Supervise([api, json, seed, out, e, c] {
-        *c = api.create(&PlannerHostApi(), json, seed, out, e, kErrorChars);
-      },
+  if (!Supervise([api, json, seed, out, e,
+                  c] { *c = api.create(&PlannerHostApi(), json, seed, out, e, kErrorChars); },
                  limits_.unbudgeted_s, where)) {
-    for (const std::shared_ptr<void>& kept : {std::shared_ptr<void>(error),
-                                              std::shared_ptr<void>(created),
-                                              std::shared_ptr<void>(instance),
-                                              std::shared_ptr<void>(config)})
+    for (const std::shared_ptr<void>& kept :
+         {std::shared_ptr<void>(error), std::shared_ptr<void>(created),
+          std::shared_ptr<void>(instance), std::shared_ptr<void>(config)})
       internal::KeepAlive(kept);
     return Status(StatusCode::kInternal, fault_->Describe(name_ + " (" + label + ")"));
   }

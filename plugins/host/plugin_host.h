@@ -53,8 +53,8 @@ struct PlannerLimits {
 struct PlannerFault {
   enum class Kind { kCrashed, kHung };
   Kind kind = Kind::kCrashed;
-  std::string call;         // "entry", "create", "plan" or "destroy"
-  uint32_t call_index = 0;  // plan: PlanRequest::call_index
+  std::string call;                     // "entry", "create", "plan" or "destroy"
+  uint32_t call_index = 0;              // plan: PlanRequest::call_index
   PlanEvent event = PlanEvent::kStart;  // plan: PlanRequest::event
   int signal = 0;                       // kCrashed: the signal number
   std::string signal_name;              // kCrashed: "SIGSEGV", ...

@@ -24,8 +24,9 @@ Status PlannerLimits::Validate() const {
   if (!(min_s > 0.0) || !std::isfinite(min_s))
     return InvalidArgument("planner hard limit: the minimum must be a number of seconds > 0");
   if (!(unbudgeted_s > 0.0) || !std::isfinite(unbudgeted_s))
-    return InvalidArgument("planner hard limit: the limit without a budget must be a number of "
-                           "seconds > 0");
+    return InvalidArgument(
+        "planner hard limit: the limit without a budget must be a number of "
+        "seconds > 0");
   return Status::Ok();
 }
 
@@ -54,7 +55,7 @@ bool LoadedPlanner::Supervise(const std::function<void()>& call, double limit_s,
   const internal::CallOutcome outcome = thread_->Run(call, limit_s);
   if (outcome.kind == internal::CallOutcome::Kind::kReturned) return true;
   fault.kind = outcome.kind == internal::CallOutcome::Kind::kCrashed ? PlannerFault::Kind::kCrashed
-                                                                    : PlannerFault::Kind::kHung;
+                                                                     : PlannerFault::Kind::kHung;
   fault.signal = outcome.signal;
   if (outcome.signal != 0) fault.signal_name = internal::SignalName(outcome.signal);
   fault.elapsed_s = outcome.elapsed_s;

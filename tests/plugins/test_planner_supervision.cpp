@@ -6,8 +6,8 @@
 #include <signal.h>
 
 #include <atomic>
-#include <cmath>
 #include <chrono>
+#include <cmath>
 #include <memory>
 #include <string>
 #include <thread>
@@ -81,9 +81,9 @@ void ExpectCrashOnCall(const std::string& fault, uint32_t call, int signal, cons
   EXPECT_EQ((*planner)->fault(), nullptr);
   auto crashed = (*planner)->Plan(world, Request(PlanEvent::kRobotIdle, call));
   ASSERT_FALSE(crashed.ok());
-  EXPECT_TRUE(Contains(crashed.status().message(),
-                       std::string("planner faulty crashed (") + name + ") in plan call " +
-                           std::to_string(call) + " (robot_idle)"))
+  EXPECT_TRUE(Contains(crashed.status().message(), std::string("planner faulty crashed (") + name +
+                                                       ") in plan call " + std::to_string(call) +
+                                                       " (robot_idle)"))
       << crashed.status().message();
   const PlannerFault* f = (*planner)->fault();
   ASSERT_NE(f, nullptr);
@@ -97,7 +97,8 @@ void ExpectCrashOnCall(const std::string& fault, uint32_t call, int signal, cons
   // Dead from now on: refused without calling it (a call would crash again).
   auto again = (*planner)->Plan(world, Request(PlanEvent::kStart, call));
   ASSERT_FALSE(again.ok());
-  EXPECT_TRUE(Contains(again.status().message(), "is not called again")) << again.status().message();
+  EXPECT_TRUE(Contains(again.status().message(), "is not called again"))
+      << again.status().message();
   planner->reset();  // neither destroyed nor unloaded: no crash here either
   ExpectHostUsable(world);
 }
@@ -124,7 +125,8 @@ TEST(PlannerSupervision, CrashInCreateIsReportedWithTheCall) {
   PlannerFault fault;
   auto planner = LoadPlanner("faulty", Options(R"({"fault": "null", "in": "create"})"), &fault);
   ASSERT_FALSE(planner.ok());
-  EXPECT_TRUE(Contains(planner.status().message(), "planner faulty (")) << planner.status().message();
+  EXPECT_TRUE(Contains(planner.status().message(), "planner faulty ("))
+      << planner.status().message();
   EXPECT_TRUE(Contains(planner.status().message(), "crashed (SIGSEGV) in create"))
       << planner.status().message();
   EXPECT_EQ(fault.kind, PlannerFault::Kind::kCrashed);
@@ -135,7 +137,8 @@ TEST(PlannerSupervision, CrashInCreateIsReportedWithTheCall) {
 
 TEST(PlannerSupervision, PlanPastItsHardLimitIsGivenUp) {
   const test::FakeWorld world;
-  auto planner = LoadPlanner("faulty", Options(R"({"fault": "loop", "call": 1})", Limits(4.0, 0.3, 60.0)));
+  auto planner =
+      LoadPlanner("faulty", Options(R"({"fault": "loop", "call": 1})", Limits(4.0, 0.3, 60.0)));
   ASSERT_TRUE(planner.ok()) << planner.status().message();
   ASSERT_TRUE((*planner)->Plan(world, Request(PlanEvent::kStart, 0, 0.05)).ok());
   const Stopwatch clock;
@@ -162,8 +165,8 @@ TEST(PlannerSupervision, PlanPastItsHardLimitIsGivenUp) {
 
 TEST(PlannerSupervision, HangInCreateIsGivenUp) {
   PlannerFault fault;
-  auto planner = LoadPlanner("faulty", Options(R"({"fault": "loop", "in": "create"})", Limits(10, 2, 0.2)),
-                             &fault);
+  auto planner = LoadPlanner(
+      "faulty", Options(R"({"fault": "loop", "in": "create"})", Limits(10, 2, 0.2)), &fault);
   ASSERT_FALSE(planner.ok());
   EXPECT_TRUE(Contains(planner.status().message(), "hung in create")) << planner.status().message();
   EXPECT_EQ(fault.kind, PlannerFault::Kind::kHung);
@@ -181,7 +184,7 @@ TEST(PlannerSupervision, AHungPlannerNoLongerReachesTheWorld) {
   EXPECT_GT(seen, 0);  // it was asking until the host gave it up
   std::this_thread::sleep_for(std::chrono::milliseconds(100));
   EXPECT_EQ(world->queries.load(), seen);  // still spinning, but refused
-  world.reset();  // the world may go: the plugin cannot touch it
+  world.reset();                           // the world may go: the plugin cannot touch it
   std::this_thread::sleep_for(std::chrono::milliseconds(20));
 }
 
@@ -190,8 +193,8 @@ TEST(PlannerSupervision, HardLimitsAreAMultipleOfTheBudgetWithAFloor) {
   EXPECT_DOUBLE_EQ(limits.For(1.0), 10.0);
   EXPECT_DOUBLE_EQ(limits.For(0.05), 2.0);
   EXPECT_DOUBLE_EQ(limits.For(0.0), 60.0);
-  for (const PlannerLimits& bad : {Limits(0.5, 2, 60), Limits(10, 0, 60), Limits(10, 2, -1),
-                                   Limits(NAN, 2, 60)}) {
+  for (const PlannerLimits& bad :
+       {Limits(0.5, 2, 60), Limits(10, 0, 60), Limits(10, 2, -1), Limits(NAN, 2, 60)}) {
     EXPECT_FALSE(bad.Validate().ok());
     auto refused = LoadPlanner("minimal", Options("{}", bad));
     ASSERT_FALSE(refused.ok());

@@ -29,14 +29,28 @@ const std::string kGuard = "timeout 120";
 
 // A tiny run: one robot, 30 simulated seconds, coarse voxels and small images.
 std::vector<std::string> TinyRun(const fs::path& config, const fs::path& out) {
-  return {"explore",      "--scene",      "apartment:size=S,seed=1",
-          "--robots",     "1",            "--planner",
-          VOXPLAN_FAULTY_PLANNER,         "--planner-config",
-          config.string(), "--max-time",  "30",
-          "--voxel-size", "0.1",          "--width",
-          "80",           "--height",     "60",
-          "--eval-samples", "20",         "--no-noise",
-          "--out",        out.string()};
+  return {"explore",
+          "--scene",
+          "apartment:size=S,seed=1",
+          "--robots",
+          "1",
+          "--planner",
+          VOXPLAN_FAULTY_PLANNER,
+          "--planner-config",
+          config.string(),
+          "--max-time",
+          "30",
+          "--voxel-size",
+          "0.1",
+          "--width",
+          "80",
+          "--height",
+          "60",
+          "--eval-samples",
+          "20",
+          "--no-noise",
+          "--out",
+          out.string()};
 }
 
 fs::path Config(const test::TempDir& dir, const std::string& json) {
@@ -54,8 +68,8 @@ size_t Lines(const std::string& text) {
 
 // Every output of the run exists and is readable; returns metrics.json.
 nlohmann::json ExpectOutputs(const fs::path& out, size_t plan_calls) {
-  for (const char* f : {"mesh.ply", "metrics.json", "timeseries.csv", "run_log.csv",
-                        "topdown.png", "plan_log.txt", "plan_calls.csv"})
+  for (const char* f : {"mesh.ply", "metrics.json", "timeseries.csv", "run_log.csv", "topdown.png",
+                        "plan_log.txt", "plan_calls.csv"})
     EXPECT_TRUE(fs::is_regular_file(out / f)) << f;
   EXPECT_EQ(ReadAll(out / "mesh.ply").rfind("ply\n", 0), 0u);
   EXPECT_EQ(ReadAll(out / "topdown.png").substr(1, 3), "PNG");
@@ -72,8 +86,7 @@ nlohmann::json ExpectOutputs(const fs::path& out, size_t plan_calls) {
 TEST(ExploreFaultsCli, ACrashingPlannerEndsTheRunWithExit3AndEveryOutput) {
   test::TempDir dir("explore_crash");
   const fs::path out = dir / "out";
-  const RunResult r =
-      RunCli(TinyRun(Config(dir, R"({"fault": "null", "call": 1})"), out), kGuard);
+  const RunResult r = RunCli(TinyRun(Config(dir, R"({"fault": "null", "call": 1})"), out), kGuard);
   ASSERT_EQ(r.exit_code, 3) << Describe(r);
   EXPECT_NE(r.err.find("error: planner faulty crashed (SIGSEGV) in plan call 1 ("),
             std::string::npos)
@@ -95,8 +108,8 @@ TEST(ExploreFaultsCli, AHangingPlannerIsGivenUpAtTheHardLimit) {
   test::TempDir dir("explore_hang");
   const fs::path out = dir / "out";
   std::vector<std::string> args = TinyRun(Config(dir, R"({"fault": "loop", "call": 0})"), out);
-  for (const char* a : {"--plan-budget", "0.05", "--planner-hard-limit", "4",
-                        "--planner-hard-limit-min", "0.3"})
+  for (const char* a :
+       {"--plan-budget", "0.05", "--planner-hard-limit", "4", "--planner-hard-limit-min", "0.3"})
     args.push_back(a);
   const RunResult r = RunCli(args, kGuard);
   ASSERT_EQ(r.exit_code, 3) << Describe(r);  // not 124: the spinning thread did not hold it
@@ -115,8 +128,8 @@ TEST(ExploreFaultsCli, AHangingPlannerIsGivenUpAtTheHardLimit) {
 
 TEST(ExploreFaultsCli, ACrashInCreateExits3BeforeAnyOutput) {
   test::TempDir dir("explore_create_crash");
-  const RunResult r = RunCli(
-      TinyRun(Config(dir, R"({"fault": "abort", "in": "create"})"), dir / "out"), kGuard);
+  const RunResult r =
+      RunCli(TinyRun(Config(dir, R"({"fault": "abort", "in": "create"})"), dir / "out"), kGuard);
   EXPECT_EQ(r.exit_code, 3) << Describe(r);
   EXPECT_NE(r.err.find("crashed (SIGABRT) in create"), std::string::npos) << Describe(r);
   EXPECT_FALSE(fs::exists(dir / "out"));
