@@ -116,3 +116,5 @@ Result<PlanResult> LoadedPlanner::Plan(const PlannerWorld& world, const PlanRequ
   }
   return Finish(world, validation, request, name_, *state);
 }
+
+}  // namespace voxplan

@@ -43,7 +43,7 @@ int Recurse(int depth) {
 void Misbehave(const std::string& fault, const vp::WorldView* world) {
   if (fault == "null") *g_null = 1;
   if (fault == "abort") std::abort();
-  if (fault == "fpe") g_spins = uint64_t(1 / g_zero);
+  if (fault == "fpe") g_spins = uint64_t(int(g_spins + 7) / g_zero);  // not 1 / x: GCC folds that
   if (fault == "stack") g_spins = uint64_t(Recurse(0));
   if (fault == "loop")
     for (;;) g_spins = g_spins + 1;
