@@ -102,6 +102,7 @@ class Explorer {
   Status UpdateFloor();
   std::vector<PlannerRobot> Snapshot() const;
   void CallPlanner(PlanEvent event, int32_t event_robot, const PlannerTask& failed);
+  void EndOnFault(const PlannerFault& fault, const std::string& head, PlanCallRecord record);
   void Record(bool with_completeness);
   double DistanceTotal() const;
   struct CameraAim {
@@ -548,6 +549,10 @@ void Explorer::CallPlanner(PlanEvent event, int32_t event_robot, const PlannerTa
                            PlanEventName(event) +
                            (event_robot >= 0 ? " robot " + std::to_string(event_robot) : "") +
                            "): ";
+  if (!plan.ok() && planner_.fault() != nullptr) {
+    EndOnFault(*planner_.fault(), head, record);
+    return;
+  }
   if (!plan.ok()) {
     // Not "no task": the robots keep their queues and the next event or interval asks again.
     result_.plan_log.push_back(head + "plan failed: " + plan.status().message());
@@ -607,6 +612,17 @@ void Explorer::CallPlanner(PlanEvent event, int32_t event_robot, const PlannerTa
     result_.plan_log.push_back(head +
                                "no task for any robot while all are idle, twice: counted as done");
   }
+}
+
+// The planner crashed or hung: it is never called again, so the run ends with what it has.
+void Explorer::EndOnFault(const PlannerFault& fault, const std::string& head,
+                          PlanCallRecord record) {
+  record.tasks_per_robot.assign(robots_.size(), 0);
+  record.elapsed_ms = fault.elapsed_s * 1e3;
+  result_.plan_calls.push_back(record);
+  result_.plan_log.push_back(head + fault.Describe(planner_.name()) + "; the run ends here");
+  result_.planner_fault = fault;
+  done_ = true;
 }
 
 double Explorer::DistanceTotal() const {
@@ -706,7 +722,9 @@ Result<ExploreResult> Explorer::Run(const std::vector<Eigen::Vector2f>& starts) 
     }
   }
 
-  result_.terminated = done_ ? "done" : "time_limit";
+  result_.terminated = result_.planner_fault ? result_.planner_fault->Terminated()
+                       : done_               ? "done"
+                                             : "time_limit";
   double t_end = t_s_;
   for (const RobotRun& r : robots_) t_end = std::max(t_end, r.t_s);
   result_.time_s = t_end;

@@ -21,7 +21,9 @@
 // are not simulated (as in Dong 2019).
 //
 // Termination: "done" when the planner says so, or when a call leaves every robot idle with no
-// task twice in a row ("no_tasks"); "time_limit" at max_time_s of simulated time.
+// task twice in a row ("no_tasks"); "time_limit" at max_time_s of simulated time;
+// "planner_crashed" / "planner_hung" when a plan call crashed or overran its hard limit
+// (LoadedPlanner::fault()): the loop stops there and the result holds what it recorded so far.
 #include <Eigen/Core>
 #include <functional>
 #include <memory>
@@ -131,7 +133,7 @@ struct ExploreTimings {  // wall milliseconds, summed over the run
 };
 
 struct ExploreResult {
-  std::string terminated;   // "done" or "time_limit"
+  std::string terminated;   // "done", "time_limit", "planner_crashed" or "planner_hung"
   std::string done_reason;  // "planner", "no_tasks" or "" (time limit)
   double time_s = 0.0;
   size_t frames_fused = 0;
@@ -142,7 +144,8 @@ struct ExploreResult {
   std::vector<RobotTrack> tracks;  // one per robot: r0, r1, ...
   std::vector<std::vector<PlannerTask>> task_views;  // per robot, views it reached, in order
   std::vector<PlanCallRecord> plan_calls;
-  std::vector<std::string> plan_log;  // rejections, failures and the plugin's messages
+  std::vector<std::string> plan_log;          // rejections, failures and the plugin's messages
+  std::optional<PlannerFault> planner_fault;  // the call that ended the run, for planner_*
   std::vector<RunTimePoint> series;
   ExploreTimings timings;
   // The maps at the end.

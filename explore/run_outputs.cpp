@@ -39,6 +39,18 @@ Status WriteLines(const std::vector<std::string>& lines, const std::string& path
   return WriteFileAtomically(path, text);
 }
 
+// The call a planner crashed or hung in; elapsed_s is wall time.
+json FaultObject(const PlannerFault& f) {
+  json j;
+  j["call"] = f.call;
+  j["call_index"] = f.call_index;
+  j["event"] = PlanEventName(f.event);
+  j["signal"] = f.kind == PlannerFault::Kind::kCrashed ? json(f.signal_name) : json(nullptr);
+  j["elapsed_s"] = RoundTo(f.elapsed_s, 3);
+  j["hard_limit_s"] = RoundTo(f.limit_s, 3);
+  return j;
+}
+
 json MetricsObject(const ExploreRunParams& params, const ExploreRunReport& report) {
   const ExploreResult& r = report.loop;
   const MeshEvalResult& quality = report.quality;
@@ -83,6 +95,7 @@ json MetricsObject(const ExploreRunParams& params, const ExploreRunReport& repor
   m["frames_fused"] = r.frames_fused;
   m["terminated"] = r.terminated;
   m["done_reason"] = r.done_reason;
+  if (r.planner_fault) m["planner_fault"] = FaultObject(*r.planner_fault);
   return m;
 }
 

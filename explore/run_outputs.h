@@ -3,7 +3,8 @@
 // formats scripts/explore-suite and the tests read back:
 //   mesh.ply        the final mesh of the fused map
 //   metrics.json    completeness (see completeness_reference), accuracy, distances, balance,
-//                   times, plan calls, termination; all but plan_ms_* repeat for a seed
+//                   times, plan calls, termination (with planner_fault: the call a planner
+//                   crashed or hung in); all but plan_ms_* and the fault's times repeat for a seed
 //   timeseries.csv  coverage, completeness (every 30 s, volume estimate), distance vs time
 //   run_log.csv     every robot's poses and status (eval/eval_run.h format)
 //   topdown.png     the final floor map, each robot's path, start / end marks, reached views

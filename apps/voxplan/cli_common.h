@@ -26,8 +26,9 @@
 namespace voxplan::cli {
 
 inline constexpr int kExitOk = 0;
-inline constexpr int kExitFailure = 1;  // I/O, data or library failures
-inline constexpr int kExitUsage = 2;    // bad arguments, refused before any work
+inline constexpr int kExitFailure = 1;       // I/O, data or library failures
+inline constexpr int kExitUsage = 2;         // bad arguments, refused before any work
+inline constexpr int kExitPlannerFault = 3;  // explore: the planner crashed or hung
 
 // A parsed subcommand and the function that runs it once CLI11 is done.
 struct Command {

@@ -3,6 +3,8 @@
 // before any work (exit 2), the planner loading, progress on stderr and the summary JSON line.
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
+#include <cstdlib>
 #include <filesystem>
 #include <iostream>
 #include <memory>
@@ -54,7 +56,18 @@ struct ExploreOptions {
   double fuse_step_m = 0.25, fuse_step_deg = 15.0;
   int threads = 0;
   MemoryBudgetOptions memory;
+  PlannerLimits limits;  // --planner-hard-limit, --planner-hard-limit-min
 };
+
+// After a planner fault its thread may still run (hung) and its library's state be anything:
+// exit() would run static destructors (the plugin's among them) beside it, so the process ends
+// here, streams flushed, outputs already written.
+[[noreturn]] void ExitAfterPlannerFault() {
+  std::cout.flush();
+  std::cerr.flush();
+  std::fflush(nullptr);
+  std::_Exit(kExitPlannerFault);
+}
 
 std::string Join(const std::vector<std::string>& items) {
   std::string out;
@@ -70,6 +83,14 @@ int CheckUsage(const ExploreOptions& o, std::vector<Eigen::Vector2f>* starts) {
   if (!(o.fov_deg > kMinFovDeg && o.fov_deg < kMaxFovDeg))
     return Fail("--fov-deg must lie strictly between " + Num(kMinFovDeg) + " and " +
                     Num(kMaxFovDeg) + " degrees, got " + Num(o.fov_deg),
+                kExitUsage);
+  if (!(o.limits.budget_factor >= 1.0 && std::isfinite(o.limits.budget_factor)))
+    return Fail("--planner-hard-limit must be a factor >= 1 of --plan-budget, got " +
+                    Num(o.limits.budget_factor),
+                kExitUsage);
+  if (!(o.limits.min_s > 0.0 && std::isfinite(o.limits.min_s)))
+    return Fail("--planner-hard-limit-min must be a finite number of seconds > 0, got " +
+                    Num(o.limits.min_s),
                 kExitUsage);
   if (!(o.max_range_m > kMinRangeM && o.max_range_m <= bounds::kDepthMaxM))
     return Fail("--max-range-m must be a finite number of metres above " + Num(kMinRangeM) +
@@ -112,8 +133,17 @@ int LoadPlannerOption(const ExploreOptions& o, std::unique_ptr<LoadedPlanner>* o
     if (std::find(available.begin(), available.end(), o.planner) == available.end())
       return Fail("unknown planner '" + o.planner + "'; available: " + Join(available), kExitUsage);
   }
-  Result<std::unique_ptr<LoadedPlanner>> planner = LoadPlanner(
-      o.planner, {.config_json = config_json, .seed = o.run.explore.seed, .search_path = {}});
+  PlannerFault fault;  // its call stays empty unless the plugin crashed or hung loading
+  Result<std::unique_ptr<LoadedPlanner>> planner = LoadPlanner(o.planner,
+                                                               {.config_json = config_json,
+                                                                .seed = o.run.explore.seed,
+                                                                .search_path = {},
+                                                                .limits = o.limits},
+                                                               &fault);
+  if (!planner.ok() && !fault.call.empty()) {
+    Fail(planner.status().message() + "; nothing was run", kExitPlannerFault);
+    ExitAfterPlannerFault();
+  }
   if (!planner.ok()) return Fail(planner.status().message(), kExitUsage);
   *out = std::move(planner).value();
   return kExitOk;
@@ -185,6 +215,13 @@ int RunExploreCommand(const ExploreOptions& o) {
             << RoundTo(report->metrics.distance_total_m, 1) << " m, " << r.plan_calls.size()
             << " plan calls -> " << run.out_dir << std::endl;
   PrintJsonLine(j);
+  if (r.planner_fault) {
+    Fail(r.planner_fault->Describe(planner->name()) +
+             "; the run ended at t=" + Num(RoundTo(r.time_s, 1)) + " s with " + r.terminated +
+             ", its outputs are in " + run.out_dir,
+         kExitPlannerFault);
+    ExitAfterPlannerFault();
+  }
   return kExitOk;
 }
 
@@ -245,6 +282,13 @@ Command AddExploreCommand(CLI::App& app) {
            "Simulated seconds between re-planning calls");
   positive("--plan-budget", run.explore.plan_time_budget_s,
            "Wall seconds a plan call should take at most");
+  sub->add_option("--planner-hard-limit", o->limits.budget_factor,
+                  "A plan call running this many times --plan-budget (but at least "
+                  "--planner-hard-limit-min) is given up: the run ends as planner_hung, exit 3")
+      ->capture_default_str();
+  sub->add_option("--planner-hard-limit-min", o->limits.min_s,
+                  "Seconds: the least hard limit of a plan call")
+      ->capture_default_str();
   positive("--eval-samples", run.eval_samples_per_m2,
            "Ground-truth samples per m² for completeness and accuracy");
   positive("--fuse-step", o->fuse_step_m, "Metres of camera travel between fused frames");

@@ -1,8 +1,10 @@
 #pragma once
 // What the host's three plan-call files share: the memory behind the opaque C handles and the
 // small conversions both the C table and the validation use. Not for use outside plugins/host.
+#include <atomic>
 #include <cmath>
 #include <initializer_list>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -24,6 +26,8 @@ struct vp_world {
   mutable std::vector<std::vector<float>> buffers;  // fields, matrices, paths; never reused
   std::vector<voxplan::PlannerRobot> robots;
   std::vector<std::vector<vp_task>> queues;
+  // Host functions inside `world` now; kRevoked added once the host gave the plugin up.
+  mutable std::atomic<int> gate{0};
 };
 
 struct vp_plan_output {
@@ -33,6 +37,36 @@ struct vp_plan_output {
 };
 
 namespace voxplan::internal {
+
+inline constexpr int kRevoked = 1 << 30;
+
+// One host function's use of w->world: ok() is false once the host revoked the handle.
+class WorldEntry {
+ public:
+  explicit WorldEntry(const vp_world& w) : w_(w), ok_(w.gate.fetch_add(1) >= 0) {}
+  ~WorldEntry() { w_.gate.fetch_sub(1); }
+  bool ok() const { return ok_; }
+
+ private:
+  const vp_world& w_;
+  bool ok_;
+};
+
+// Stops every later host function from reading w.world, and waits (at most wait_s) for those
+// inside it to leave. The host functions are short: a plugin stuck inside one is a host bug.
+void Revoke(const vp_world& w, double wait_s);
+
+// Memory a crashed or hung plugin may still touch: never freed, and still reachable (so leak
+// checkers do not report it).
+void KeepAlive(std::shared_ptr<void> memory);
+
+// One plan() call's host memory, on the heap so it can outlive the call when the plugin does.
+struct PlanCallState {
+  voxplan::PlanResult result;
+  vp_world world;
+  vp_plan_output out;
+  vp_status status = VP_OK;
+};
 
 inline vp_task ToC(const PlannerTask& t) {
   return {t.position_m.x(),   t.position_m.y(), t.theta_rad, t.camera_yaw_rad,

@@ -44,6 +44,16 @@ vp_status Guarded(F&& f) noexcept {
   }
 }
 
+// Guarded, and only while the host has not revoked the world: a plugin the host gave up on may
+// still run, and the world it was shown may be gone.
+template <class F>
+vp_status InWorld(const vp_world* w, F&& f) noexcept {
+  if (w == nullptr) return VP_ERROR_INVALID_ARGUMENT;
+  const internal::WorldEntry entry(*w);
+  if (!entry.ok()) return VP_ERROR_INTERNAL;
+  return Guarded(f);
+}
+
 // Copies `full` into a struct the plugin sized: at most out->struct_size bytes.
 template <class T>
 vp_status FillSized(T* out, const T& full) {
@@ -73,7 +83,7 @@ void Log(const vp_world* w, int32_t level, const char* message) {
 }
 
 vp_status GetMapInfo(const vp_world* w, vp_map_info* out) {
-  return Guarded([&]() -> vp_status {
+  return InWorld(w, [&]() -> vp_status {
     if (!w) return VP_ERROR_INVALID_ARGUMENT;
     const PlannerMapInfo m = w->world->MapInfo();
     vp_map_info info{};
@@ -90,7 +100,7 @@ vp_status GetMapInfo(const vp_world* w, vp_map_info* out) {
 }
 
 vp_status VoxelStates(const vp_world* w, const float* xyz, uint64_t count, uint8_t* out) {
-  return Guarded([&]() -> vp_status {
+  return InWorld(w, [&]() -> vp_status {
     if (!w || (count > 0 && (!xyz || !out))) return VP_ERROR_INVALID_ARGUMENT;
     std::vector<Eigen::Vector3f> points(count);
     for (uint64_t i = 0; i < count; ++i) points[i] = {xyz[3 * i], xyz[3 * i + 1], xyz[3 * i + 2]};
@@ -102,7 +112,7 @@ vp_status VoxelStates(const vp_world* w, const float* xyz, uint64_t count, uint8
 }
 
 vp_status Raycast(const vp_world* w, const vp_ray* rays, uint64_t count, vp_ray_hit* out) {
-  return Guarded([&]() -> vp_status {
+  return InWorld(w, [&]() -> vp_status {
     if (!w || (count > 0 && (!rays || !out))) return VP_ERROR_INVALID_ARGUMENT;
     std::vector<PlannerRay> in(count);
     for (uint64_t i = 0; i < count; ++i) {
@@ -125,7 +135,7 @@ vp_status Raycast(const vp_world* w, const vp_ray* rays, uint64_t count, vp_ray_
 }
 
 vp_status GetFrontierVoxels(const vp_world* w, const float** out, uint64_t* count) {
-  return Guarded([&]() -> vp_status {
+  return InWorld(w, [&]() -> vp_status {
     if (!w || !out || !count) return VP_ERROR_INVALID_ARGUMENT;
     if (!w->have_frontier) {
       for (const Eigen::Vector3f& p : w->world->FrontierVoxels()) {
@@ -140,7 +150,7 @@ vp_status GetFrontierVoxels(const vp_world* w, const float** out, uint64_t* coun
 }
 
 vp_status GetSurfaceVoxels(const vp_world* w, const vp_surface_voxel** out, uint64_t* count) {
-  return Guarded([&]() -> vp_status {
+  return InWorld(w, [&]() -> vp_status {
     if (!w || !out || !count) return VP_ERROR_INVALID_ARGUMENT;
     if (!w->have_surface) {
       const std::vector<SurfaceVoxel> voxels = w->world->SurfaceVoxels();
@@ -165,7 +175,7 @@ vp_status GetSurfaceVoxels(const vp_world* w, const vp_surface_voxel** out, uint
 }
 
 vp_status GetFloor(const vp_world* w, vp_floor* out) {
-  return Guarded([&]() -> vp_status {
+  return InWorld(w, [&]() -> vp_status {
     if (!w) return VP_ERROR_INVALID_ARGUMENT;
     const PlannerFloor& f = w->world->Floor();
     const size_t n = size_t(std::max(f.width, 0)) * size_t(std::max(f.height, 0));
@@ -201,7 +211,7 @@ vp_status StatusToC(const Status& s) {
 
 vp_status GeodesicField(const vp_world* w, const float source[2], float min_clearance_m,
                         const float** out) {
-  return Guarded([&]() -> vp_status {
+  return InWorld(w, [&]() -> vp_status {
     if (!w || !source || !out || !AllFinite({source[0], source[1], min_clearance_m})) {
       return VP_ERROR_INVALID_ARGUMENT;
     }
@@ -216,7 +226,7 @@ vp_status GeodesicField(const vp_world* w, const float source[2], float min_clea
 
 vp_status DistanceMatrix(const vp_world* w, const float* xy, uint32_t count, float min_clearance_m,
                          const float** out) {
-  return Guarded([&]() -> vp_status {
+  return InWorld(w, [&]() -> vp_status {
     if (!w || !out || (count > 0 && !xy) || !std::isfinite(min_clearance_m)) {
       return VP_ERROR_INVALID_ARGUMENT;
     }
@@ -237,7 +247,7 @@ vp_status DistanceMatrix(const vp_world* w, const float* xy, uint32_t count, flo
 
 vp_status ShortestPath(const vp_world* w, const float from[2], const float to[2],
                        float min_clearance_m, const float** out, uint32_t* count) {
-  return Guarded([&]() -> vp_status {
+  return InWorld(w, [&]() -> vp_status {
     if (!w || !from || !to || !out || !count ||
         !AllFinite({from[0], from[1], to[0], to[1], min_clearance_m})) {
       return VP_ERROR_INVALID_ARGUMENT;
@@ -256,7 +266,7 @@ vp_status ShortestPath(const vp_world* w, const float from[2], const float to[2]
 }
 
 vp_status GetInstances(const vp_world* w, const vp_instance** out, uint32_t* count) {
-  return Guarded([&]() -> vp_status {
+  return InWorld(w, [&]() -> vp_status {
     if (!w || !out || !count) return VP_ERROR_INVALID_ARGUMENT;
     if (!w->have_instances) {
       const std::vector<ObjectInstance> objects = w->world->Instances();

@@ -6,8 +6,13 @@
 
 #include <algorithm>
 #include <cstdlib>
+#include <cstring>
 #include <set>
 #include <system_error>
+
+#include "plugins/host/elf_check.h"
+#include "plugins/host/host_internal.h"
+#include "plugins/host/planner_thread.h"
 
 #ifndef VOXPLAN_PLANNER_BUILD_DIR
 #define VOXPLAN_PLANNER_BUILD_DIR ""
@@ -43,6 +48,9 @@ std::string DlError() {
   const char* e = dlerror();
   return e ? e : "unknown dlopen error";
 }
+
+// A name or version string from the plugin's static storage, read at most this far.
+std::string BoundedName(const char* s) { return std::string(s, strnlen(s, 256)); }
 
 // Closes the library unless released: every early return below unloads it.
 struct LibraryGuard {
@@ -85,51 +93,49 @@ std::vector<std::string> AvailablePlanners(const std::vector<fs::path>& search_p
   return {names.begin(), names.end()};
 }
 
-LoadedPlanner::~LoadedPlanner() {
-  if (instance_ && api_.destroy) api_.destroy(instance_);
-  if (library_) dlclose(library_);
-}
+namespace {
 
-Result<std::unique_ptr<LoadedPlanner>> LoadPlanner(const std::string& name_or_path,
-                                                   const PlannerLoadOptions& options) {
-  fs::path path;
+// The file a name or path stands for.
+Result<fs::path> FindPlanner(const std::string& name_or_path, const PlannerLoadOptions& options) {
   if (IsPath(name_or_path)) {
-    path = name_or_path;
-    if (!fs::exists(path)) return NotFound("planner plugin " + name_or_path + " does not exist");
-  } else {
-    const std::vector<fs::path> search =
-        options.search_path.empty() ? DefaultPlannerSearchPath() : options.search_path;
-    const std::vector<std::string> available = AvailablePlanners(search);
-    if (!IsPlannerName(name_or_path) ||
-        std::find(available.begin(), available.end(), name_or_path) == available.end()) {
-      return NotFound("unknown planner '" + name_or_path + "'; available: " +
-                      (available.empty() ? std::string("none") : Join(available)) +
-                      " (set VOXPLAN_PLANNER_PATH or pass a path to a .so)");
-    }
+    if (!fs::exists(name_or_path))
+      return NotFound("planner plugin " + name_or_path + " does not exist");
+    return fs::path(name_or_path);
+  }
+  const std::vector<fs::path> search =
+      options.search_path.empty() ? DefaultPlannerSearchPath() : options.search_path;
+  const std::vector<std::string> available = AvailablePlanners(search);
+  if (IsPlannerName(name_or_path) &&
+      std::find(available.begin(), available.end(), name_or_path) != available.end()) {
     for (const fs::path& dir : search) {
       const fs::path candidate = dir / (kPrefix + name_or_path + kSuffix);
-      if (fs::exists(candidate)) {
-        path = candidate;
-        break;
-      }
+      if (fs::exists(candidate)) return candidate;
     }
   }
-  const std::string label = path.string();
+  return NotFound("unknown planner '" + name_or_path +
+                  "'; available: " + (available.empty() ? std::string("none") : Join(available)) +
+                  " (set VOXPLAN_PLANNER_PATH or pass a path to a .so)");
+}
 
-  dlerror();  // clear a stale message
-  LibraryGuard library{dlopen(path.c_str(), RTLD_NOW | RTLD_LOCAL)};
-  if (!library.handle) return IoError("cannot load planner " + label + ": " + DlError());
-  dlerror();
-  void* symbol = dlsym(library.handle, VP_PLANNER_ENTRY_SYMBOL);
-  if (!symbol) {
-    return InvalidArgument("planner " + label + " has no " + VP_PLANNER_ENTRY_SYMBOL +
-                           " symbol; is it a voxplan planner (built with VP_PLANNER_EXPORT)?");
-  }
-  vp_planner_entry_fn entry = reinterpret_cast<vp_planner_entry_fn>(symbol);
+}  // namespace
 
+LoadedPlanner::LoadedPlanner() = default;
+
+// The entry call (on the planner thread) and the checks of the table it returns.
+Status LoadedPlanner::Negotiate(vp_planner_entry_fn entry, const std::string& label) {
   vp_planner_api api{};
   api.struct_size = sizeof(api);
-  const vp_status status = entry(VP_PLANNER_ABI_VERSION, &PlannerHostApi(), &api);
+  vp_status status = VP_OK;
+  vp_planner_api* out = &api;
+  vp_status* status_out = &status;
+  PlannerFault where;
+  where.call = "entry";
+  if (!Supervise(
+          [entry, out, status_out] {
+            *status_out = entry(VP_PLANNER_ABI_VERSION, &PlannerHostApi(), out);
+          },
+          limits_.unbudgeted_s, where))
+    return Status(StatusCode::kInternal, fault_->Describe(label));
   if (api.abi_version == 0) {
     return Unsupported("plugin " + label + " did not report its planner ABI version (status " +
                        std::to_string(status) + "); this voxplan speaks ABI " +
@@ -154,25 +160,91 @@ Result<std::unique_ptr<LoadedPlanner>> LoadPlanner(const std::string& name_or_pa
   if (!api.create || !api.plan || !api.destroy || !api.name) {
     return Unsupported("plugin " + label + " returned an incomplete planner table");
   }
+  api_ = api;
+  name_ = BoundedName(api.name);
+  version_ = api.version ? BoundedName(api.version) : "";
+  return Status::Ok();
+}
 
-  std::unique_ptr<LoadedPlanner> planner(new LoadedPlanner());
-  planner->name_ = api.name;
-  planner->version_ = api.version ? api.version : "";
-  planner->path_ = path;
-  planner->api_ = api;
-  char error[kErrorChars] = {};
-  const vp_status created = api.create(&PlannerHostApi(), options.config_json.c_str(), options.seed,
-                                       &planner->instance_, error, kErrorChars);
-  error[kErrorChars - 1] = '\0';  // in case the plugin forgot
-  if (created != VP_OK || !planner->instance_) {
-    planner->instance_ = nullptr;  // a failed create owns nothing we may destroy
-    return InvalidArgument("planner " + planner->name_ + " (" + label +
-                           ") could not be created (status " + std::to_string(created) +
-                           "): " + (error[0] ? error : "no message"));
+// The plugin's create (on the planner thread).
+Status LoadedPlanner::Create(const PlannerLoadOptions& options, const std::string& label) {
+  // On the heap: a create the host gives up on may still write the message.
+  auto error = std::make_shared<std::vector<char>>(kErrorChars, '\0');
+  auto created = std::make_shared<vp_status>(VP_OK);
+  auto instance = std::make_shared<vp_planner*>(nullptr);
+  auto config = std::make_shared<std::string>(options.config_json);
+  const vp_planner_api api = api_;
+  const uint64_t seed = options.seed;
+  char* e = error->data();
+  vp_status* c = created.get();
+  vp_planner** out = instance.get();
+  const char* json = config->c_str();
+  PlannerFault where;
+  where.call = "create";
+  if (!Supervise([api, json, seed, out, e,
+                  c] { *c = api.create(&PlannerHostApi(), json, seed, out, e, kErrorChars); },
+                 limits_.unbudgeted_s, where)) {
+    for (const std::shared_ptr<void>& kept :
+         {std::shared_ptr<void>(error), std::shared_ptr<void>(created),
+          std::shared_ptr<void>(instance), std::shared_ptr<void>(config)})
+      internal::KeepAlive(kept);
+    return Status(StatusCode::kInternal, fault_->Describe(name_ + " (" + label + ")"));
   }
-  planner->library_ = library.handle;
+  e[kErrorChars - 1] = '\0';  // in case the plugin forgot
+  if (*c != VP_OK || *out == nullptr) {
+    // A failed create owns nothing we may destroy.
+    return InvalidArgument("planner " + name_ + " (" + label + ") could not be created (status " +
+                           std::to_string(*c) + "): " + (e[0] ? e : "no message"));
+  }
+  instance_ = *out;
+  return Status::Ok();
+}
+
+LoadedPlanner::~LoadedPlanner() {
+  if (!fault_ && instance_ && api_.destroy) {
+    const vp_planner_api api = api_;
+    vp_planner* instance = instance_;
+    PlannerFault where;
+    where.call = "destroy";
+    (void)Supervise([api, instance] { api.destroy(instance); }, limits_.unbudgeted_s, where);
+  }
+  // After a fault the plugin's code may still run (hung) or its state be anything: it stays.
+  if (library_ && !fault_) dlclose(library_);
+}
+
+Result<std::unique_ptr<LoadedPlanner>> LoadPlanner(const std::string& name_or_path,
+                                                   const PlannerLoadOptions& options,
+                                                   PlannerFault* fault) {
+  VOXPLAN_RETURN_IF_ERROR(options.limits.Validate());
+  Result<fs::path> found = FindPlanner(name_or_path, options);
+  if (!found.ok()) return found.status();
+  const fs::path path = *found;
+  const std::string label = path.string();
+  VOXPLAN_RETURN_IF_ERROR(internal::CheckSharedObject(label));
+
+  dlerror();  // clear a stale message
+  LibraryGuard library{dlopen(path.c_str(), RTLD_NOW | RTLD_LOCAL)};
+  if (!library.handle) return IoError("cannot load planner " + label + ": " + DlError());
+  dlerror();
+  void* symbol = dlsym(library.handle, VP_PLANNER_ENTRY_SYMBOL);
+  if (!symbol) {
+    return InvalidArgument("planner " + label + " has no " + VP_PLANNER_ENTRY_SYMBOL +
+                           " symbol; is it a voxplan planner (built with VP_PLANNER_EXPORT)?");
+  }
+  Result<std::unique_ptr<internal::PlannerThread>> thread = internal::PlannerThread::Start();
+  if (!thread.ok()) return thread.status();
+  std::unique_ptr<LoadedPlanner> planner(new LoadedPlanner());
+  planner->path_ = path;
+  planner->name_ = path.filename().string();  // until the plugin names itself
+  planner->limits_ = options.limits;
+  planner->thread_ = std::move(thread).value();
+  planner->library_ = library.handle;  // from here the planner decides whether to unload
   library.handle = nullptr;
-  return planner;
+  Status negotiated = planner->Negotiate(reinterpret_cast<vp_planner_entry_fn>(symbol), label);
+  if (negotiated.ok()) negotiated = planner->Create(options, label);
+  if (negotiated.ok()) return planner;
+  if (planner->fault_ && fault) *fault = *planner->fault_;
+  return negotiated;
 }
 
 }  // namespace voxplan

@@ -8,14 +8,23 @@
 // A name is looked up as libvoxplan_planner_<name>.so in the search path: $VOXPLAN_PLANNER_PATH
 // (colon-separated) first, then the folder the build puts planners in. The host refuses, with a
 // Status and never a crash, a file it cannot dlopen, a missing entry symbol, another ABI
-// version, a table of the wrong size and a failing create. The plugin's output is validated
-// against the world: non-finite numbers, tasks outside the bounds, in or too near an obstacle,
-// in unknown space or unreachable are rejected one by one, logged in PlanResult, and the rest
-// kept. A plan call slower than its budget is measured and flagged, not interrupted.
+// version, a table of the wrong size and a failing create; and, before dlopen, a file that is
+// not a whole shared object for this machine (plugins/host/elf_check.h). The plugin's output is
+// validated against the world: non-finite numbers, tasks outside the bounds, in or too near an
+// obstacle, in unknown space or unreachable are rejected one by one, logged in PlanResult, and
+// the rest kept. A plan call slower than its budget is flagged; one slower than its hard limit
+// (PlannerLimits) is given up.
+//
+// Supervision (plugins/host/README.md): every call into the plugin (entry, create, plan,
+// destroy) runs on the planner's own thread. A crash there (SIGSEGV, SIGBUS, SIGFPE, SIGILL,
+// SIGABRT) or a call past its hard limit makes the call fail with a PlannerFault; the planner
+// is dead from then on (fault() says why): never called, destroyed or unloaded again.
 #include <Eigen/Core>
 #include <cstdint>
 #include <filesystem>
+#include <functional>
 #include <memory>
+#include <optional>
 #include <string>
 #include <utility>
 #include <vector>
@@ -26,11 +35,43 @@
 
 namespace voxplan {
 
+namespace internal {
+class PlannerThread;  // plugins/host/planner_thread.h
+}  // namespace internal
+
+// How long the host waits for a call into the plugin before it gives the plugin up.
+struct PlannerLimits {
+  double budget_factor = 10.0;  // a plan call with a budget: this many budgets ...
+  double min_s = 2.0;           // ... but never less than this
+  double unbudgeted_s = 60.0;   // a plan call without a budget, and entry / create / destroy
+  double For(double budget_s) const;
+  // InvalidArgument naming the field unless factor >= 1 and both times are finite and > 0.
+  Status Validate() const;
+};
+
+// A call the plugin crashed in or overran its hard limit in.
+struct PlannerFault {
+  enum class Kind { kCrashed, kHung };
+  Kind kind = Kind::kCrashed;
+  std::string call;                     // "entry", "create", "plan" or "destroy"
+  uint32_t call_index = 0;              // plan: PlanRequest::call_index
+  PlanEvent event = PlanEvent::kStart;  // plan: PlanRequest::event
+  int signal = 0;                       // kCrashed: the signal number
+  std::string signal_name;              // kCrashed: "SIGSEGV", ...
+  double elapsed_s = 0.0;               // wall time until the crash, or until the host gave up
+  double limit_s = 0.0;                 // the call's hard limit
+  // "planner_crashed" or "planner_hung".
+  const char* Terminated() const;
+  // "planner greedy crashed (SIGSEGV) in plan call 3 (interval) after 0.01 s"
+  std::string Describe(const std::string& planner) const;
+};
+
 struct PlannerLoadOptions {
   std::string config_json = "{}";
   uint64_t seed = 0;
   // Folders searched for a planner given by name; empty means DefaultPlannerSearchPath().
   std::vector<std::filesystem::path> search_path;
+  PlannerLimits limits;
 };
 
 // $VOXPLAN_PLANNER_PATH entries, then the build's planner folder.
@@ -104,7 +145,8 @@ struct PlanValidation {
   float max_dwell_s = 600.f;
 };
 
-// A loaded plugin with one planner instance; destroys the instance and unloads on destruction.
+// A loaded plugin with one planner instance; destroys the instance and unloads on destruction
+// (unless it faulted: then both are left alone, and a hung thread left running).
 class LoadedPlanner {
  public:
   LoadedPlanner(const LoadedPlanner&) = delete;
@@ -116,25 +158,41 @@ class LoadedPlanner {
   const std::filesystem::path& path() const { return path_; }
 
   // One planning call. An error Status when the plugin's plan fails (with its message); the
-  // output's problems are rejections inside the result instead.
+  // output's problems are rejections inside the result instead. When the plugin crashes or
+  // overruns limits().For(request.time_budget_s), an error and fault() set; every later call
+  // fails at once.
   Result<PlanResult> Plan(const PlannerWorld& world, const PlanRequest& request,
                           const PlanValidation& validation = {});
 
+  // The call that killed the planner; null while it is healthy.
+  const PlannerFault* fault() const { return fault_ ? &*fault_ : nullptr; }
+  const PlannerLimits& limits() const { return limits_; }
+
  private:
   friend Result<std::unique_ptr<LoadedPlanner>> LoadPlanner(const std::string&,
-                                                            const PlannerLoadOptions&);
-  LoadedPlanner() = default;
+                                                            const PlannerLoadOptions&,
+                                                            PlannerFault*);
+  LoadedPlanner();
+  // Runs `call` on the planner thread; false (and fault_ set) when it crashed or hung.
+  bool Supervise(const std::function<void()>& call, double limit_s, PlannerFault fault);
+  Status Negotiate(vp_planner_entry_fn entry, const std::string& label);
+  Status Create(const PlannerLoadOptions& options, const std::string& label);
 
   void* library_ = nullptr;
   vp_planner_api api_{};
   vp_planner* instance_ = nullptr;
   std::string name_, version_;
   std::filesystem::path path_;
+  PlannerLimits limits_;
+  std::unique_ptr<internal::PlannerThread> thread_;
+  std::optional<PlannerFault> fault_;
 };
 
-// name_or_path: a path (holds a '/' or ends in ".so") or a planner name.
+// name_or_path: a path (holds a '/' or ends in ".so") or a planner name. When the plugin
+// crashes or hangs in its entry or create, the error says so and *fault (if given) is set.
 Result<std::unique_ptr<LoadedPlanner>> LoadPlanner(const std::string& name_or_path,
-                                                   const PlannerLoadOptions& options = {});
+                                                   const PlannerLoadOptions& options = {},
+                                                   PlannerFault* fault = nullptr);
 
 // The host's function table handed to every plugin (static storage).
 const vp_host_api& PlannerHostApi();

@@ -56,8 +56,9 @@ const Scene& SmallApartment() {
 }
 
 std::unique_ptr<LoadedPlanner> Greedy() {
-  Result<std::unique_ptr<LoadedPlanner>> planner = LoadPlanner(
-      VOXPLAN_EXPLORE_TEST_PLANNER, {.config_json = "{}", .seed = 3, .search_path = {}});
+  Result<std::unique_ptr<LoadedPlanner>> planner =
+      LoadPlanner(VOXPLAN_EXPLORE_TEST_PLANNER,
+                  {.config_json = "{}", .seed = 3, .search_path = {}, .limits = {}});
   EXPECT_TRUE(planner.ok()) << planner.status().message();
   return planner.ok() ? std::move(planner).value() : nullptr;
 }
@@ -113,8 +114,8 @@ TEST(Explore, ViewsTiltTheCameraTowardsUnknownFloorAndDriveLevel) {
   Result<std::vector<Eigen::Vector2f>> starts =
       ChooseStarts(s.plan, s.world.rooms, 2, params.robot.radius_m);
   ASSERT_TRUE(starts.ok()) << starts.status().message();
-  Result<std::unique_ptr<LoadedPlanner>> omt =
-      LoadPlanner(VOXPLAN_OMT_TEST_PLANNER, {.config_json = "{}", .seed = 3, .search_path = {}});
+  Result<std::unique_ptr<LoadedPlanner>> omt = LoadPlanner(
+      VOXPLAN_OMT_TEST_PLANNER, {.config_json = "{}", .seed = 3, .search_path = {}, .limits = {}});
   ASSERT_TRUE(omt.ok()) << omt.status().message();
   Result<ExploreResult> run = RunExplore(s.world, s.plan, *starts, **omt, params, {});
   ASSERT_TRUE(run.ok()) << run.status().message();
@@ -237,7 +238,8 @@ std::unique_ptr<LoadedPlanner> Goto(const Eigen::Vector2f& goal_W) {
   const std::string config =
       "{\"x\": " + std::to_string(goal_W.x()) + ", \"y\": " + std::to_string(goal_W.y()) + "}";
   Result<std::unique_ptr<LoadedPlanner>> planner =
-      LoadPlanner(VOXPLAN_GOTO_TEST_PLANNER, {.config_json = config, .seed = 1, .search_path = {}});
+      LoadPlanner(VOXPLAN_GOTO_TEST_PLANNER,
+                  {.config_json = config, .seed = 1, .search_path = {}, .limits = {}});
   EXPECT_TRUE(planner.ok()) << planner.status().message();
   return planner.ok() ? std::move(planner).value() : nullptr;
 }

@@ -20,8 +20,9 @@ namespace {
 namespace fs = std::filesystem;
 
 std::unique_ptr<LoadedPlanner> Greedy() {
-  Result<std::unique_ptr<LoadedPlanner>> planner = LoadPlanner(
-      VOXPLAN_EXPLORE_TEST_PLANNER, {.config_json = "{}", .seed = 5, .search_path = {}});
+  Result<std::unique_ptr<LoadedPlanner>> planner =
+      LoadPlanner(VOXPLAN_EXPLORE_TEST_PLANNER,
+                  {.config_json = "{}", .seed = 5, .search_path = {}, .limits = {}});
   EXPECT_TRUE(planner.ok()) << planner.status().message();
   return planner.ok() ? std::move(planner).value() : nullptr;
 }
