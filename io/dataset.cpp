@@ -12,6 +12,7 @@
 #include <string>
 #include <utility>
 
+#include "core/bounds.h"
 #include "io/dataset_internal.h"
 #include "io/file_util.h"
 #include "io/image_io.h"
@@ -54,6 +55,14 @@ Status CheckFocalLengths(double fx, double fy, const std::string& file, int line
       return line > 0 ? LineError(file, line, why) : CorruptData(file + ": " + why);
   }
   return Status::Ok();
+}
+
+Result<int> StatedImageSide(double v, const std::string& file, const char* key) {
+  // Checked before the cast: int() of a double out of range is undefined behaviour.
+  if (!(v >= 1.0 && v <= double(bounds::kImageSideMax) && v == std::floor(v)))
+    return CorruptData(file + ": " + key + " " + NumberText(v) + " must be a whole number of " +
+                       "pixels in [1, " + std::to_string(bounds::kImageSideMax) + "]");
+  return int(v);
 }
 
 int LineOf(const std::string& path, const std::string& text) {

@@ -78,6 +78,9 @@ Result<Eigen::Matrix4d> ParseMatrixRows(const TextFile& f, size_t first);
 // Refuses focal lengths read from `file` that are not positive and finite, as file:line.
 // (ICL-NUIM's negative fy is that format's built-in default; camera.txt passes |fy|.)
 Status CheckFocalLengths(double fx, double fy, const std::string& file, int line);
+// An image side stated in `file` (key `key`), refused unless a whole number in
+// [1, bounds::kImageSideMax].
+Result<int> StatedImageSide(double v, const std::string& file, const char* key);
 // The 1-based line of the first occurrence of `text` in `path` (for JSON values), else 0.
 int LineOf(const std::string& path, const std::string& text);
 // Warns, naming both numbers, when a pose list holds a different number of poses than there

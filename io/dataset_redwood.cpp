@@ -69,8 +69,12 @@ Status ReadRedwoodCamera(const std::string& path, Draft& d) {
     if (!w.ok()) return w.status();
     auto h = JsonNumber(j, "height", path);
     if (!h.ok()) return h.status();
-    d.stated_width = int(*w);
-    d.stated_height = int(*h);
+    auto width = StatedImageSide(*w, path, "width");
+    if (!width.ok()) return width.status();
+    auto height = StatedImageSide(*h, path, "height");
+    if (!height.ok()) return height.status();
+    d.stated_width = *width;
+    d.stated_height = *height;
   }
   return Status::Ok();
 }

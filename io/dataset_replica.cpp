@@ -59,8 +59,12 @@ Result<Draft> ReadReplica(const fs::path& root) {
     if (!x.ok()) return x.status();
     v[i] = *x;
   }
-  d.stated_width = int(v[0]);
-  d.stated_height = int(v[1]);
+  auto width = StatedImageSide(v[0], params, "w");
+  if (!width.ok()) return width.status();
+  auto height = StatedImageSide(v[1], params, "h");
+  if (!height.ok()) return height.status();
+  d.stated_width = *width;
+  d.stated_height = *height;
   d.intrinsics[0] = float(v[2]);
   d.intrinsics[1] = float(v[3]);
   d.intrinsics[2] = float(v[4]);

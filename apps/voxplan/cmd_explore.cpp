@@ -11,9 +11,9 @@
 #include <sstream>
 
 #include "apps/voxplan/cli_common.h"
-#include "core/bounds.h"
 #include "apps/voxplan/path_check.h"
 #include "apps/voxplan/signals.h"
+#include "core/bounds.h"
 #include "core/parallel.h"
 #include "explore/explore_run.h"
 #include "explore/run_outputs.h"

@@ -8,9 +8,9 @@
 #include <sstream>
 
 #include "apps/voxplan/cli_common.h"
-#include "core/bounds.h"
 #include "apps/voxplan/path_check.h"
 #include "apps/voxplan/signals.h"
+#include "core/bounds.h"
 #include "core/parallel.h"
 #include "core/volume.h"
 #include "fusion/integrate.h"

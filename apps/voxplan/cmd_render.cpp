@@ -8,9 +8,9 @@
 #include <tuple>
 
 #include "apps/voxplan/cli_common.h"
-#include "core/bounds.h"
 #include "apps/voxplan/path_check.h"
 #include "apps/voxplan/signals.h"
+#include "core/bounds.h"
 #include "core/parallel.h"
 #include "io/image_io.h"
 #include "io/map_io.h"

@@ -8,8 +8,8 @@
 #include <memory>
 
 #include "apps/voxplan/cli_common.h"
-#include "core/bounds.h"
 #include "apps/voxplan/path_check.h"
+#include "core/bounds.h"
 #include "core/parallel.h"
 #include "io/file_util.h"
 #include "io/tum_trajectory.h"

@@ -677,6 +677,17 @@ TEST(DatasetsBadInput, RedwoodAndReplica) {
     ExpectError(OpenDataset(dir.path().string()).status(), {"camera_primesense.json", "320x240"});
   }
   {
+    // Found by fuzz_dataset: int(1e30) was undefined behaviour (UBSan float-cast-overflow).
+    SCOPED_TRACE("stated size beyond int");
+    test::TempDir dir("redwood");
+    make_redwood(dir.path());
+    WriteText(dir / "camera_primesense.json",
+              "{\"width\": 1e30, \"height\": 480, \"intrinsic_matrix\": [525, 0, 0, 0, 525, 0, "
+              "319.5, 239.5, 1]}");
+    ExpectError(OpenDataset(dir.path().string()).status(),
+                {"camera_primesense.json", "width", "whole number"});
+  }
+  {
     SCOPED_TRACE("malformed json");
     test::TempDir dir("redwood");
     make_redwood(dir.path());
@@ -716,6 +727,18 @@ TEST(DatasetsBadInput, RedwoodAndReplica) {
               "{\"camera\": {\"w\": 640, \"h\": 480, \"fx\": 600.0, \"fy\": 600.0, \"cx\": 599.5, "
               "\"cy\": 339.5, \"scale\": 6553.5}}");
     ExpectError(OpenDataset(dir.path().string()).status(), {"cam_params.json", "640x480"});
+  }
+  {
+    // Found by fuzz_dataset: int(4e20) was undefined behaviour (UBSan float-cast-overflow).
+    SCOPED_TRACE("stated size beyond int");
+    test::TempDir dir("replica");
+    make_replica(dir.path());
+    WriteText(dir / "office0/traj.txt", "1 0 0 0 0 1 0 0 0 0 1 0 0 0 0 1\n");
+    WriteText(dir / "cam_params.json",
+              "{\"camera\": {\"w\": 4e20, \"h\": 680, \"fx\": 600.0, \"fy\": 600.0, \"cx\": 599.5, "
+              "\"cy\": 339.5, \"scale\": 6553.5}}");
+    ExpectError(OpenDataset(dir.path().string()).status(),
+                {"cam_params.json", "w ", "whole number"});
   }
 }
 
