@@ -2,7 +2,9 @@
 
 #include <unistd.h>
 
+#include <algorithm>
 #include <atomic>
+#include <cctype>
 #include <cerrno>
 #include <cstdio>
 #include <cstring>
@@ -72,6 +74,13 @@ Status WriteStringToFile(const std::string& path, std::string_view data) {
     return IoError("cannot write " + path + ": " +
                    std::strerror(n != data.size() ? write_errno : errno));
   return Status::Ok();
+}
+
+std::string LowerExtension(const std::string& path) {
+  std::string ext = std::filesystem::path(path).extension().string();
+  std::transform(ext.begin(), ext.end(), ext.begin(),
+                 [](unsigned char c) { return char(std::tolower(c)); });
+  return ext;
 }
 
 Result<std::string> ReadFileToString(const std::string& path) {

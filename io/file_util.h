@@ -22,6 +22,9 @@ Status WriteStringToFile(const std::string& path, std::string_view data);
 // WriteAtomically of WriteStringToFile: `data` replaces `path` whole or not at all.
 Status WriteFileAtomically(const std::string& path, std::string_view data);
 
+// The extension of `path` in lower case, with its dot (".ply"), or "".
+std::string LowerExtension(const std::string& path);
+
 // Reads a whole file; the error names the file.
 Result<std::string> ReadFileToString(const std::string& path);
 

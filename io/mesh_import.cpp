@@ -23,13 +23,6 @@ namespace fs = std::filesystem;
 
 namespace {
 
-std::string LowerExtension(const std::string& path) {
-  std::string ext = fs::path(path).extension().string();
-  std::transform(ext.begin(), ext.end(), ext.begin(),
-                 [](unsigned char c) { return char(std::tolower(c)); });
-  return ext;
-}
-
 // Opens only regular files inside one folder (after resolving symlinks and ".."), for reading:
 // an OBJ's mtllib or a glTF's buffer cannot reach outside the mesh's folder, nor block on a
 // FIFO or device. A refused file looks missing to assimp, which then goes on without it.

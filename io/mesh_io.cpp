@@ -22,13 +22,6 @@ namespace voxplan {
 
 namespace {
 
-std::string LowerExtension(const std::string& path) {
-  std::string ext = std::filesystem::path(path).extension().string();
-  std::transform(ext.begin(), ext.end(), ext.begin(),
-                 [](unsigned char c) { return char(std::tolower(c)); });
-  return ext;
-}
-
 // Binary little-endian PLY written directly: assimp's PLY exporter stores colours as floats
 // (r, g, b, a), which most tools read as non-standard properties; uchar red/green/blue is what
 // MeshLab, Open3D and assimp itself expect.

@@ -11,6 +11,7 @@
 #include <filesystem>
 
 #include "io/assimp_material.h"
+#include "io/file_util.h"
 #include "io/mesh_import.h"
 #include "io/mesh_io.h"
 #include "io/ply_reader.h"
@@ -18,13 +19,6 @@
 namespace voxplan {
 
 namespace {
-
-std::string LowerExtension(const std::string& path) {
-  std::string ext = std::filesystem::path(path).extension().string();
-  std::transform(ext.begin(), ext.end(), ext.begin(),
-                 [](unsigned char c) { return char(std::tolower(c)); });
-  return ext;
-}
 
 uint8_t ToByte(float c) {
   if (!std::isfinite(c)) return 0;
