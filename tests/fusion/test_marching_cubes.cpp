@@ -18,19 +18,6 @@ TsdfVolume FillExact(const Sdf& sdf, float voxel, float trunc, const Eigen::Vect
   return test::FillExactSdf(sdf, {voxel, trunc}, lo, hi);
 }
 
-// Every undirected edge used by exactly two triangles, in opposite directions.
-void ExpectClosedAndConsistentlyOriented(const Mesh& mesh) {
-  std::map<std::pair<uint32_t, uint32_t>, int> directed;
-  for (const auto& t : mesh.triangles)
-    for (int k = 0; k < 3; ++k) directed[{t[k], t[(k + 1) % 3]}]++;
-  size_t bad = 0;
-  for (const auto& [e, n] : directed) {
-    const auto it = directed.find({e.second, e.first});
-    bad += (n != 1 || it == directed.end() || it->second != 1);
-  }
-  EXPECT_EQ(bad, 0u) << "edges not shared by exactly two opposite triangles";
-}
-
 TEST(MarchingCubes, TableCoversEveryCaseConsistently) {
   const auto& table = internal::MarchingCubesTable();
   EXPECT_EQ(table[0].num_triangles, 0);
@@ -52,7 +39,7 @@ TEST(MarchingCubes, SphereIsClosedOnTheSurfaceWithTheRightArea) {
                                       c + Eigen::Vector3f::Constant(0.5f));
   const Mesh mesh = ExtractMesh(volume);
   ASSERT_GT(mesh.num_triangles(), 1000u);
-  ExpectClosedAndConsistentlyOriented(mesh);
+  EXPECT_EQ(test::EdgesNotClosed(mesh), 0u) << "edges not shared by exactly two opposite triangles";
 
   double area = 0.0;
   for (const auto& t : mesh.triangles)

@@ -50,19 +50,6 @@ void ExpectClean(const Mesh& mesh, const std::string& what) {
   EXPECT_EQ(d.unused_vertices, 0u) << what << ": vertices no triangle uses";
 }
 
-// Every undirected edge used by exactly two triangles, in opposite directions.
-size_t EdgesNotClosed(const Mesh& mesh) {
-  std::map<std::pair<uint32_t, uint32_t>, int> directed;
-  for (const auto& t : mesh.triangles)
-    for (int k = 0; k < 3; ++k) directed[{t[k], t[(k + 1) % 3]}]++;
-  size_t bad = 0;
-  for (const auto& [e, n] : directed) {
-    const auto it = directed.find({e.second, e.first});
-    bad += (n != 1 || it == directed.end() || it->second != 1);
-  }
-  return bad;
-}
-
 double Area(const Mesh& mesh) {
   double area = 0.0;
   for (const auto& t : mesh.triangles)
@@ -104,7 +91,7 @@ TEST(CleanMesh, ExactZeroCornersGiveOneVertexAndNoZeroAreaTriangle) {
   const Mesh mesh = ExtractMesh(volume);
   ASSERT_GT(mesh.num_triangles(), 500u);
   ExpectClean(mesh, "octahedron");
-  EXPECT_EQ(EdgesNotClosed(mesh), 0u) << "edges not shared by exactly two opposite triangles";
+  EXPECT_EQ(test::EdgesNotClosed(mesh), 0u) << "edges not shared by exactly two opposite triangles";
   // The exact octahedron, up to the TSDF's 16-bit fixed point.
   const double true_area = 4.0 * std::sqrt(3.0) * double(kRadius) * double(kRadius);
   EXPECT_NEAR(Area(mesh) / true_area, 1.0, 1e-3);

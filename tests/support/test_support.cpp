@@ -8,6 +8,7 @@
 #include <cstdlib>
 #include <cstring>
 #include <limits>
+#include <map>
 
 namespace voxplan::test {
 
@@ -133,6 +134,18 @@ void ExpectSameImages(const RaycastImages& a, const RaycastImages& b) {
   EXPECT_TRUE(same(a.vertex_W, b.vertex_W)) << "vertex_W";
   EXPECT_TRUE(same(a.normal_W, b.normal_W)) << "normal_W";
   EXPECT_TRUE(same(a.color, b.color)) << "color";
+}
+
+size_t EdgesNotClosed(const Mesh& mesh) {
+  std::map<std::pair<uint32_t, uint32_t>, int> directed;
+  for (const auto& t : mesh.triangles)
+    for (int k = 0; k < 3; ++k) directed[{t[k], t[(k + 1) % 3]}]++;
+  size_t bad = 0;
+  for (const auto& [e, n] : directed) {
+    const auto it = directed.find({e.second, e.first});
+    bad += (n != 1 || it == directed.end() || it->second != 1);
+  }
+  return bad;
 }
 
 }  // namespace voxplan::test

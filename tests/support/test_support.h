@@ -8,6 +8,7 @@
 
 #include "core/camera.h"
 #include "core/image.h"
+#include "core/mesh.h"
 #include "core/pose.h"
 #include "core/raycast.h"
 #include "core/volume.h"
@@ -59,6 +60,10 @@ TsdfVolume FillExactSdf(const std::function<float(const Eigen::Vector3f&)>& sdf,
                         const Eigen::Vector3f& hi, bool all_blocks = false);
 
 using voxplan::LookAt;  // core/pose.h; tests may still write test::LookAt
+
+// Directed edges of a closed, consistently oriented mesh that are not matched by exactly one
+// opposite edge (0 for such a mesh).
+size_t EdgesNotClosed(const Mesh& mesh);
 
 // Every image of two ray casts is the same, byte for byte (NaNs included); a failure names the
 // image.
