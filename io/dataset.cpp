@@ -106,6 +106,8 @@ Result<nlohmann::json> ReadJson(const std::string& path) {
     const size_t byte = std::min<size_t>(e.byte, text.size());
     const int line = 1 + int(std::count(text.begin(), text.begin() + long(byte), '\n'));
     return LineError(path, line, std::string("invalid JSON: ") + e.what());
+  } catch (const nlohmann::json::exception& e) {  // e.g. a number too large for a double (1e309)
+    return InvalidArgument(path + ": invalid JSON: " + e.what());
   }
 }
 

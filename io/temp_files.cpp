@@ -36,9 +36,12 @@ int Remember(std::atomic<char*>* slots, int n, const std::string& path) {
 
 bool Forget(std::atomic<char*>* slots, int n, int slot) {
   if (slot < 0 || slot >= n) return false;
+  // Once RemoveTempFiles has begun (a signal: the process is about to exit) the handler may be
+  // reading the copy: it stays in its slot, neither freed nor lost (leak checkers still reach it).
+  if (g_removing.load()) return slots[slot].load() != nullptr;
   char* copy = slots[slot].exchange(nullptr);
   if (copy == nullptr) return false;
-  if (!g_removing.load()) delete[] copy;
+  delete[] copy;
   return true;
 }
 

@@ -81,7 +81,9 @@ std::vector<float> Clearance(const FloorPlan& plan) {
     }
   const float res = plan.resolution_m, diag = res * std::numbers::sqrt2_v<float>;
   while (!queue.empty()) {
-    const auto [d, i] = queue.top();
+    // Plain locals, not a structured binding: the lambda below captures them (clang 14).
+    const float d = queue.top().first;
+    const int i = queue.top().second;
     queue.pop();
     if (d > dist[size_t(i)]) continue;
     const int x = i % plan.width, y = i / plan.width;
@@ -112,7 +114,9 @@ Dijkstra RunDijkstra(const Grid& grid, int source) {
   out.dist[size_t(source)] = 0.f;
   queue.push({0.f, source});
   while (!queue.empty()) {
-    const auto [d, i] = queue.top();
+    // Plain locals, not a structured binding: the lambda below captures them (clang 14).
+    const float d = queue.top().first;
+    const int i = queue.top().second;
     queue.pop();
     if (d > out.dist[size_t(i)]) continue;
     grid.ForNeighbours(i, [&](int j, float step) {

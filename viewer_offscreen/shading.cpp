@@ -173,7 +173,9 @@ Result<ColorImage> Shade(const SurfaceImages& surface, const PinholeCamera& came
   ColorImage out(w, h, mode == ShadeMode::kDepth ? PackRgb(0, 0, 0) : params.background);
 
   if (mode == ShadeMode::kDepth) {
-    auto [near_m, far_m] = std::pair(params.depth_near_m, params.depth_far_m);
+    // Plain locals, not a structured binding: the lambda below captures far_m (clang 14).
+    float near_m = params.depth_near_m;
+    float far_m = params.depth_far_m;
     if (!(near_m < far_m)) std::tie(near_m, far_m) = AutoDepthRange(surface.depth);
     const float inv_range = 1.0f / (far_m - near_m);
     ForEachRow(h, [&](int v) {

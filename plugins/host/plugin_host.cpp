@@ -223,7 +223,11 @@ Result<std::unique_ptr<LoadedPlanner>> LoadPlanner(const std::string& name_or_pa
   VOXPLAN_RETURN_IF_ERROR(internal::CheckSharedObject(label));
 
   dlerror();  // clear a stale message
-  LibraryGuard library{dlopen(path.c_str(), RTLD_NOW | RTLD_LOCAL)};
+  // RTLD_NODELETE: dlclose drops the reference but never unmaps. The libraries a planner links
+  // statically (Ceres, glog) set up state in their static initialisers and may register exit
+  // handlers; unmapping them would orphan that memory (LeakSanitizer reports it) or leave a
+  // handler pointing at unmapped code. Loading the same file again reuses the mapping.
+  LibraryGuard library{dlopen(path.c_str(), RTLD_NOW | RTLD_LOCAL | RTLD_NODELETE)};
   if (!library.handle) return IoError("cannot load planner " + label + ": " + DlError());
   dlerror();
   void* symbol = dlsym(library.handle, VP_PLANNER_ENTRY_SYMBOL);

@@ -688,6 +688,17 @@ TEST(DatasetsBadInput, RedwoodAndReplica) {
                 {"camera_primesense.json", "width", "whole number"});
   }
   {
+    // Found by fuzz_dataset: a number past double's range threw out of the reader (terminate).
+    SCOPED_TRACE("json number overflow");
+    test::TempDir dir("redwood");
+    make_redwood(dir.path());
+    WriteText(dir / "camera_primesense.json",
+              "{\"width\": 1e309, \"height\": 480, \"intrinsic_matrix\": [525, 0, 0, 0, 525, 0, "
+              "319.5, 239.5, 1]}");
+    ExpectError(OpenDataset(dir.path().string()).status(),
+                {"camera_primesense.json", "invalid JSON", "1e309"});
+  }
+  {
     SCOPED_TRACE("malformed json");
     test::TempDir dir("redwood");
     make_redwood(dir.path());
