@@ -168,6 +168,7 @@ Status Explorer::Fuse(RobotRun& r, bool force) {
                              T_W_C, ip, *volume_, map_);
   result_.timings.fuse_ms += NowMs() - t0;
   if (!stats.ok()) return stats.status();
+  result_.blocks_dropped += stats->integrate.blocks_refused;
   touched_.insert(touched_.end(), stats->integrate.touched_blocks.begin(),
                   stats->integrate.touched_blocks.end());
   ++r.frames;

@@ -140,6 +140,7 @@ struct ExploreResult {
   size_t failed_tasks = 0;
   size_t rejected_tasks = 0;
   size_t over_budget_calls = 0;
+  size_t blocks_dropped = 0;       // map blocks not allocated: the map was at max_memory_bytes
   size_t failed_plans = 0;         // plan calls the plugin failed (messages in plan_log)
   std::vector<RobotTrack> tracks;  // one per robot: r0, r1, ...
   std::vector<std::vector<PlannerTask>> task_views;  // per robot, views it reached, in order

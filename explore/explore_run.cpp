@@ -122,6 +122,10 @@ std::vector<std::string> Warnings(const ExploreResult& r, double plan_budget_s) 
   if (r.failed_plans > 0)
     warnings.push_back(std::to_string(r.failed_plans) +
                        " plan calls failed (messages in plan_log.txt)");
+  if (r.blocks_dropped > 0)
+    warnings.push_back(
+        "the map reached its memory budget (--max-memory): " + std::to_string(r.blocks_dropped) +
+        " new blocks were not allocated, so what they saw is missing from the map");
   if (r.rejected_tasks > 0)
     warnings.push_back("the planner's output was rejected " + std::to_string(r.rejected_tasks) +
                        " times (reasons in plan_log.txt)");

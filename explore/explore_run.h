@@ -55,8 +55,8 @@ struct ExploreRunReport {
   size_t tour_frames = 0;             // frames of the completeness tour
   double setup_ms = 0.0;              // wall time: scene, starts, completeness probe
   double eval_ms = 0.0;               // wall time: mesh, its file, evaluation
-  // Plan calls over budget, failed plan calls, rejected outputs, in words; for the caller to
-  // show (the counts are in `loop`).
+  // Plan calls over budget, failed plan calls, rejected outputs, map blocks dropped at the
+  // memory budget, in words; for the caller to show (the counts are in `loop`).
   std::vector<std::string> warnings;
 };
 

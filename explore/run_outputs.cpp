@@ -93,6 +93,7 @@ json MetricsObject(const ExploreRunParams& params, const ExploreRunReport& repor
   m["failed_tasks"] = r.failed_tasks;
   m["failed_plan_calls"] = r.failed_plans;
   m["frames_fused"] = r.frames_fused;
+  m["blocks_dropped_memory"] = r.blocks_dropped;
   m["terminated"] = r.terminated;
   m["done_reason"] = r.done_reason;
   if (r.planner_fault) m["planner_fault"] = FaultObject(*r.planner_fault);

@@ -105,6 +105,7 @@ TEST(ExploreRun, ShortRunWritesEveryArtefactAndItsMetricsAgree) {
   EXPECT_EQ(m["seed"], 5);
   EXPECT_EQ(m["plan_calls"], loop.plan_calls.size());
   EXPECT_EQ(m["frames_fused"], loop.frames_fused);
+  EXPECT_EQ(m["blocks_dropped_memory"], 0);
   EXPECT_EQ(m["terminated"], loop.terminated);
   EXPECT_EQ(m["distance_per_robot_m"].size(), 2u);
   EXPECT_NEAR(m["completeness"].get<double>(), report->quality.completeness, 5e-5);
@@ -117,6 +118,29 @@ TEST(ExploreRun, ShortRunWritesEveryArtefactAndItsMetricsAgree) {
   for (const RobotTrack& t : loop.tracks) samples += t.samples.size();
   EXPECT_GT(Lines(dir / "out" / "run_log.csv").size(), samples / 2);
   EXPECT_GE(Lines(dir / "out" / "timeseries.csv").size(), 2u);
+}
+
+// Past --max-memory the map takes no new blocks: the run goes on, warns and counts them.
+TEST(ExploreRun, AMapAtItsMemoryBudgetWarnsAndCountsWhatItDropped) {
+  test::TempDir dir("explore_run");
+  std::unique_ptr<LoadedPlanner> planner = Greedy();
+  ASSERT_NE(planner, nullptr);
+  ExploreRunParams params = ShortRun(dir / "out");
+  params.explore.max_time_s = 20.0;
+  params.explore.max_memory_bytes = 1u << 20;
+  Result<ExploreRunReport> report = RunExploreExperiment(params, *planner, {}, nullptr);
+  ASSERT_TRUE(report.ok()) << report.status().message();
+  EXPECT_GT(report->loop.blocks_dropped, 0u);
+  ASSERT_FALSE(report->warnings.empty());
+  bool warned = false;
+  for (const std::string& w : report->warnings) {
+    warned = warned || (w.find("memory budget") != std::string::npos &&
+                        w.find(std::to_string(report->loop.blocks_dropped)) != std::string::npos);
+  }
+  EXPECT_TRUE(warned);
+  std::ifstream metrics_file(dir / "out" / "metrics.json");
+  const nlohmann::json m = nlohmann::json::parse(metrics_file);
+  EXPECT_EQ(m["blocks_dropped_memory"], report->loop.blocks_dropped);
 }
 
 TEST(ExploreRun, RefusesABadRequestBeforeTheOutputFolderExists) {
