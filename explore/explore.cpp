@@ -60,6 +60,7 @@ struct RobotRun {
   double trajectory_t0_s = 0.0;
   double t_s = 0.0;  // this robot's time on the run clock (its Robot clock plus waiting)
   bool idle = false;
+  double idle_s = 0.0;  // of t_s, with an empty queue
   uint64_t frames = 0;
   RobotTrack track;
   std::vector<PlannerTask> views;
@@ -367,6 +368,7 @@ Status Explorer::Advance(RobotRun& r, double t_end_s) {
         Sample(r, RobotStatus::kIdle);
         went_idle_.push_back(r.index);
       }
+      r.idle_s += t_end_s - r.t_s;
       r.t_s = t_end_s;
       break;
     }
@@ -471,6 +473,9 @@ std::vector<PlannerRobot> Explorer::Snapshot() const {
     pr.min_pitch_rad = -pr.max_pitch_rad;
     pr.camera_yaw_rate_radps = rp.camera_yaw_rate_radps;
     pr.camera_pitch_rate_radps = rp.camera_pitch_rate_radps;
+    pr.distance_m = float(r.robot.distance_m());
+    pr.idle_s = float(r.idle_s);
+    pr.busy_s = float(r.t_s - r.idle_s);
     for (RobotMode m : {RobotMode::kExplorer, RobotMode::kReconstructor}) {
       const ModeParams& mp = rp.mode(m);
       const PinholeCamera cam =
@@ -488,6 +493,12 @@ std::vector<PlannerRobot> Explorer::Snapshot() const {
       sm.fy = cam.fy;
       sm.cx = cam.cx;
       sm.cy = cam.cy;
+      // Today's robot: one head camera for both modes, captured by displacement, switched free.
+      sm.mount = CameraMount::kHead;
+      sm.camera_height_min_m = sm.camera_height_max_m = rp.camera_height_m;
+      sm.min_pitch_rad = pr.min_pitch_rad;
+      sm.max_pitch_rad = pr.max_pitch_rad;
+      sm.camera_turn_rate_radps = std::min(rp.camera_yaw_rate_radps, rp.camera_pitch_rate_radps);
       pr.modes.push_back(sm);
     }
     out.push_back(std::move(pr));

@@ -17,6 +17,18 @@
  *   - Records passed in arrays (vp_task, vp_ray, vp_surface_voxel, ...) carry no size: their
  *     layout is fixed for a major version.
  *
+ * Growth within a major version (ABI 1.1 onwards):
+ *   - New host functions come as extension tables: host->get_extension(name, min_version)
+ *     returns a static table whose first fields are vp_extension_header, or NULL when the host
+ *     has no such extension at that version. Names are "vp.<area>" with the version apart, e.g.
+ *     get_extension(VP_EXT_OBJECTS, 1). A table only grows by appended fields; its version
+ *     counts the additions.
+ *   - get_extension itself was appended to vp_host_api in 1.1: a plugin that must also load on
+ *     1.0 hosts checks VP_HOST_HAS(host, get_extension) first. Plugins built against the 1.0
+ *     header never see it and keep working (tests/plugins/planners/abi1_0/ holds that header).
+ *   - vp_mode_params and vp_robot gained appended fields in 1.1 (marked); a plugin built against
+ *     1.0 sizes them smaller and gets the 1.0 prefix.
+ *
  * Memory ownership:
  *   - Pointers the host returns (arrays, strings, rasters) are host-owned, read-only and valid
  *     until the current plan() returns; the plugin copies what it keeps.
@@ -40,6 +52,8 @@ extern "C" {
 #endif
 
 #define VP_PLANNER_ABI_VERSION 1u
+/* The minor version: what this header appends to ABI 1 (see "Growth" above). */
+#define VP_PLANNER_ABI_MINOR 1u
 #define VP_PLANNER_ENTRY_SYMBOL "vp_planner_entry"
 
 #if defined(_WIN32)
@@ -168,6 +182,10 @@ typedef struct vp_floor {
   const float* clearance_m; /* distance from the cell centre to the nearest obstacle */
 } vp_floor;
 
+/* Where a mode's camera sits: at the base centre, on a head at a fixed height with a tilt, or
+ * on an arm that sets its height and its offset from the base (Guo 2022's reconstructor). */
+enum { VP_MOUNT_BASE = 0, VP_MOUNT_HEAD = 1, VP_MOUNT_ARM = 2 };
+
 /* What a scanning mode changes (Guo 2022): speed and the camera's view. */
 typedef struct vp_mode_params {
   uint32_t struct_size;
@@ -177,6 +195,17 @@ typedef struct vp_mode_params {
   float min_range_m, max_range_m;
   int32_t image_width, image_height;
   float fx, fy, cx, cy; /* pinhole intrinsics of this mode, pixels */
+  /* ---- 1.1: the camera's mount and timing. ---- */
+  int32_t mount;             /* VP_MOUNT_* */
+  float camera_height_min_m; /* optical centre above the floor; min == max: fixed */
+  float camera_height_max_m;
+  float reach_min_m, reach_max_m;     /* arm: horizontal offset from the base centre */
+  float reach_half_angle_rad;         /* arm: offset bearing within +-this of the heading */
+  float min_pitch_rad, max_pitch_rad; /* this mode's pitch range, positive looks up */
+  float camera_speed_mps;             /* arm: how fast the camera moves on its mount */
+  float camera_turn_rate_radps;       /* the slower of the camera's yaw and pitch joints */
+  float capture_hz;                   /* frames per second; 0: captured by displacement */
+  float switch_s;                     /* time to switch into this mode */
 } vp_mode_params;
 
 typedef struct vp_robot {
@@ -192,7 +221,17 @@ typedef struct vp_robot {
   float camera_height_m; /* optical centre above the floor */
   float min_pitch_rad, max_pitch_rad;
   float camera_yaw_rate_radps, camera_pitch_rate_radps;
+  /* ---- 1.1: what the robot has done so far in this run. ---- */
+  float distance_m; /* driven by the base */
+  float busy_s;     /* with a task in its queue */
+  float idle_s;     /* with none */
 } vp_robot;
+
+/* The first fields of every extension table (see get_extension). */
+typedef struct vp_extension_header {
+  uint32_t struct_size; /* bytes of the whole table */
+  uint32_t version;     /* >= the min_version asked for */
+} vp_extension_header;
 
 /* ---- The host's table: queries (valid during plan) and the output builder. ---------------- */
 typedef struct vp_host_api {
@@ -263,7 +302,30 @@ typedef struct vp_host_api {
                                const char* text, uint32_t rgba);
   /* Why plan() is about to return an error. */
   vp_status (*set_error)(vp_plan_output* o, const char* message);
+
+  /* ---- 1.1. ---- */
+  /* The named extension table at min_version or later, or NULL (see "Growth" above). May be
+   * called from create() and plan(); the table is static and valid while the plugin is loaded. */
+  const vp_extension_header* (*get_extension)(const char* name, uint32_t min_version);
 } vp_host_api;
+
+/* ---- Extensions (get_extension). ------------------------------------------------------------ */
+
+/* "vp.objects" version 1: per-object reads for object-centred planners (Guo 2022). */
+#define VP_EXT_OBJECTS "vp.objects"
+typedef struct vp_objects_ext {
+  vp_extension_header header;
+  /* The surface voxels of one instance (those get_surface_voxels gives with .instance == id), in
+   * the same order; host-owned like them. An id with no voxels gives count 0. */
+  vp_status (*get_instance_surface)(const vp_world* w, uint32_t id, const vp_surface_voxel** out,
+                                    uint64_t* out_count);
+} vp_objects_ext;
+
+/* Whether a host table has a field: a plugin that also runs on older hosts of its major version
+ * tests this before calling an appended function. */
+#define VP_HOST_HAS(host, field)                                                          \
+  ((host)->struct_size >= (uint32_t)((const char*)&(host)->field - (const char*)(host)) + \
+                              (uint32_t)sizeof((host)->field))
 
 /* ---- The plugin's table. ------------------------------------------------------------------- */
 typedef struct vp_planner_api {

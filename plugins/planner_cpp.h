@@ -181,6 +181,34 @@ class WorldView {
     return std::vector<float>(xy, xy + size_t(count) * 2);
   }
 
+  // The named extension table (planner_api.h, "Growth") at min_version or later, or nullptr.
+  // T is the table's struct (e.g. vp_objects_ext).
+  template <class T>
+  const T* Extension(const char* name, uint32_t min_version) const {
+    const vp_extension_header* h = host_->get_extension(name, min_version);
+    if (h == nullptr || h->struct_size < sizeof(T)) return nullptr;
+    return reinterpret_cast<const T*>(h);
+  }
+  // The same, or a vp::Error naming the extension when this host lacks it.
+  template <class T>
+  const T& RequireExtension(const char* name, uint32_t min_version) const {
+    const T* table = Extension<T>(name, min_version);
+    if (table == nullptr) {
+      throw Error(VP_ERROR_NOT_AVAILABLE, std::string("this host has no extension ") + name +
+                                              " version " + std::to_string(min_version) +
+                                              " or later; run it with a newer voxplan");
+    }
+    return *table;
+  }
+  // vp.objects 1: the surface voxels of one instance.
+  std::span<const vp_surface_voxel> InstanceSurface(uint32_t id) const {
+    const auto& ext = RequireExtension<vp_objects_ext>(VP_EXT_OBJECTS, 1);
+    const vp_surface_voxel* voxels = nullptr;
+    uint64_t count = 0;
+    Check(ext.get_instance_surface(world_, id, &voxels, &count), "get_instance_surface");
+    return {voxels, size_t(count)};
+  }
+
   std::span<const vp_instance> Instances() const {
     const vp_instance* instances = nullptr;
     uint32_t count = 0;

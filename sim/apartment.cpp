@@ -19,8 +19,11 @@ void ApartmentAreaRange(ApartmentSize size, float* min_m2, float* max_m2) {
     case ApartmentSize::kM:
       *min_m2 = 110.0f, *max_m2 = 200.0f;
       break;
-    default:
+    case ApartmentSize::kL:
       *min_m2 = 200.0f, *max_m2 = 350.0f;
+      break;
+    default:
+      *min_m2 = 300.0f, *max_m2 = 450.0f;
       break;
   }
 }
@@ -62,11 +65,21 @@ Result<ApartmentSize> ParseApartmentSize(const std::string& text) {
   if (text == "S" || text == "s") return ApartmentSize::kS;
   if (text == "M" || text == "m") return ApartmentSize::kM;
   if (text == "L" || text == "l") return ApartmentSize::kL;
-  return InvalidArgument("apartment size must be S, M or L, got '" + text + "'");
+  if (text == "XL" || text == "xl") return ApartmentSize::kXL;
+  return InvalidArgument("apartment size must be S, M, L or XL, got '" + text + "'");
 }
 
 const char* ApartmentSizeName(ApartmentSize size) {
-  return size == ApartmentSize::kS ? "S" : size == ApartmentSize::kM ? "M" : "L";
+  switch (size) {
+    case ApartmentSize::kS:
+      return "S";
+    case ApartmentSize::kM:
+      return "M";
+    case ApartmentSize::kL:
+      return "L";
+    default:
+      return "XL";
+  }
 }
 
 }  // namespace voxplan

@@ -39,7 +39,8 @@
 
 namespace voxplan {
 
-enum class ApartmentSize { kS, kM, kL };  // gross floor area 60-110, 110-200, 200-350 m²
+// Gross floor area 60-110, 110-200, 200-350, 300-450 m²; XL is Guo 2022's "large" (over 300).
+enum class ApartmentSize { kS, kM, kL, kXL };
 
 struct ApartmentParams {
   ApartmentSize size = ApartmentSize::kM;

@@ -21,6 +21,8 @@ struct vp_world {
   mutable bool have_frontier = false, have_surface = false, have_instances = false;
   mutable std::vector<float> frontier_xyz;
   mutable std::vector<vp_surface_voxel> surface;
+  mutable bool have_surface_by_instance = false;
+  mutable std::vector<vp_surface_voxel> surface_by_instance;  // stable-sorted by instance
   mutable std::vector<std::string> instance_labels;
   mutable std::vector<vp_instance> instances;
   mutable std::vector<std::vector<float>> buffers;  // fields, matrices, paths; never reused
@@ -95,6 +97,9 @@ inline double ElapsedS(const vp_world* w) {
   if (w == nullptr) return 0.0;
   return w->clock.ElapsedS();
 }
+
+// vp_host_api.get_extension (host_extensions.cpp).
+const vp_extension_header* GetExtension(const char* name, uint32_t min_version);
 
 // Checks what the plugin returned against the world; drops and logs what cannot be executed.
 void Validate(const PlannerWorld& world, const std::vector<PlannerRobot>& robots,

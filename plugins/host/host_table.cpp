@@ -18,6 +18,9 @@ static_assert(uint8_t(voxplan::FloorCell::kUnknown) == VP_FLOOR_UNKNOWN &&
 static_assert(uint8_t(voxplan::VoxelState::kUnobserved) == VP_VOXEL_UNOBSERVED &&
               uint8_t(voxplan::VoxelState::kFree) == VP_VOXEL_FREE &&
               uint8_t(voxplan::VoxelState::kOccupied) == VP_VOXEL_OCCUPIED);
+static_assert(int32_t(voxplan::CameraMount::kBase) == VP_MOUNT_BASE &&
+              int32_t(voxplan::CameraMount::kHead) == VP_MOUNT_HEAD &&
+              int32_t(voxplan::CameraMount::kArm) == VP_MOUNT_ARM);
 
 namespace voxplan {
 namespace {
@@ -25,6 +28,7 @@ namespace {
 using internal::AllFinite;
 using internal::ElapsedS;
 using internal::FromC;
+using internal::GetExtension;
 
 // Caps on what one plan may return, so a runaway plugin cannot exhaust memory.
 constexpr size_t kMaxTasksPerRobot = 100000;
@@ -313,6 +317,9 @@ vp_status GetRobot(const vp_world* w, uint32_t index, vp_robot* out) {
     robot.max_pitch_rad = r.max_pitch_rad;
     robot.camera_yaw_rate_radps = r.camera_yaw_rate_radps;
     robot.camera_pitch_rate_radps = r.camera_pitch_rate_radps;
+    robot.distance_m = r.distance_m;
+    robot.busy_s = r.busy_s;
+    robot.idle_s = r.idle_s;
     return FillSized(out, robot);
   });
 }
@@ -337,6 +344,18 @@ vp_status GetRobotMode(const vp_world* w, uint32_t index, uint32_t mode, vp_mode
     p.fy = m.fy;
     p.cx = m.cx;
     p.cy = m.cy;
+    p.mount = int32_t(m.mount);
+    p.camera_height_min_m = m.camera_height_min_m;
+    p.camera_height_max_m = m.camera_height_max_m;
+    p.reach_min_m = m.reach_min_m;
+    p.reach_max_m = m.reach_max_m;
+    p.reach_half_angle_rad = m.reach_half_angle_rad;
+    p.min_pitch_rad = m.min_pitch_rad;
+    p.max_pitch_rad = m.max_pitch_rad;
+    p.camera_speed_mps = m.camera_speed_mps;
+    p.camera_turn_rate_radps = m.camera_turn_rate_radps;
+    p.capture_hz = m.capture_hz;
+    p.switch_s = m.switch_s;
     return FillSized(out, p);
   });
 }
@@ -492,6 +511,7 @@ const vp_host_api kHostApi = {
     .add_debug_polyline = AddDebugPolyline,
     .add_debug_label = AddDebugLabel,
     .set_error = SetError,
+    .get_extension = GetExtension,
 };
 
 }  // namespace

@@ -90,6 +90,10 @@ struct PlannerTask {
 };
 
 // One scanning mode (Guo 2022): speed and the camera's view.
+// Where a mode's camera sits (VP_MOUNT_*): the base centre, a head at a fixed height with a tilt,
+// or an arm that sets the camera's height and offset.
+enum class CameraMount : int32_t { kBase = 0, kHead = 1, kArm = 2 };
+
 struct ScanMode {
   float max_speed_mps = 0.5f;
   float max_turn_rate_radps = 1.f;
@@ -97,6 +101,14 @@ struct ScanMode {
   float min_range_m = 0.1f, max_range_m = 5.f;
   int image_width = 640, image_height = 480;
   float fx = 320.f, fy = 320.f, cx = 320.f, cy = 240.f;
+  // The camera's mount and timing (vp_mode_params' 1.1 fields).
+  CameraMount mount = CameraMount::kHead;
+  float camera_height_min_m = 1.2f, camera_height_max_m = 1.2f;
+  float reach_min_m = 0.f, reach_max_m = 0.f, reach_half_angle_rad = 0.f;
+  float min_pitch_rad = -1.f, max_pitch_rad = 1.f;
+  float camera_speed_mps = 0.f, camera_turn_rate_radps = 1.5f;
+  float capture_hz = 0.f;  // 0: captured by displacement
+  float switch_s = 0.f;
 };
 
 struct PlannerRobot {
@@ -112,6 +124,9 @@ struct PlannerRobot {
   float min_pitch_rad = -1.f, max_pitch_rad = 1.f;
   float camera_yaw_rate_radps = 1.5f, camera_pitch_rate_radps = 1.f;
   std::vector<ScanMode> modes;  // indexed by mode
+  // This run so far.
+  float distance_m = 0.f;
+  float busy_s = 0.f, idle_s = 0.f;
 };
 
 class PlannerWorld {

@@ -94,8 +94,11 @@ int DrawOutline(ApartmentSize size, Rng& rng, GridLayout* layout) {
   const int corridor_width_u = rng.Int(24, 30);
   const double min_depth_m =
       (2 * kExteriorWallU + 2 * kInteriorWallU + corridor_width_u + 2 * kMinStripDepthU) * kUnitM;
-  double depth_lo_m = size == ApartmentSize::kS ? 6.6 : size == ApartmentSize::kM ? 7.6 : 9.6;
-  double depth_hi_m = size == ApartmentSize::kS ? 8.0 : size == ApartmentSize::kM ? 10.4 : 13.4;
+  // Depth ranges per class, S M L XL (XL: about as deep as L, a third wider).
+  constexpr double kDepthLoM[] = {6.6, 7.6, 9.6, 11.0};
+  constexpr double kDepthHiM[] = {8.0, 10.4, 13.4, 15.0};
+  double depth_lo_m = kDepthLoM[int(size)];
+  double depth_hi_m = kDepthHiM[int(size)];
   depth_lo_m = std::max({depth_lo_m, min_depth_m, std::sqrt(area_m2 / 2.3)});
   depth_hi_m = std::max(depth_lo_m, std::min(depth_hi_m, std::sqrt(area_m2 / 1.15)));
   layout->depth_u = Snap(rng.Uniform(depth_lo_m, depth_hi_m));
@@ -140,9 +143,11 @@ RoomProgram DrawProgram(ApartmentSize size, const GridLayout& layout, const Band
   program.kitchen_in_living = kitchen_in_living;
   std::vector<std::string> extra_types = {"bedroom", "bedroom", "study",
                                           "wc",      "storage", "bedroom"};
-  if (size == ApartmentSize::kL)
+  if (size == ApartmentSize::kL || size == ApartmentSize::kXL)
     extra_types = {"bedroom", "bedroom", "bathroom", "study", "bedroom",
                    "wc",      "storage", "bedroom",  "study"};
+  if (size == ApartmentSize::kXL)
+    extra_types.insert(extra_types.end(), {"bathroom", "bedroom", "storage"});
   if (size == ApartmentSize::kS) extra_types = {"bedroom", "study", "storage"};
 
   const int strip_length_u = bands.strip_length_u;

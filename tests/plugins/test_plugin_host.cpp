@@ -132,7 +132,7 @@ TEST(PluginHost, UnknownNameListsTheAvailablePlanners) {
   EXPECT_TRUE(Contains(m, "unknown planner 'nosuch'")) << m;
   EXPECT_TRUE(Contains(m, "garbage, goto, minimal, noentry, probe, throwing")) << m;
   const std::vector<std::string> names = AvailablePlanners({kDir});
-  EXPECT_EQ(names.front(), "abi2");  // sorted
+  EXPECT_EQ(names.front(), "abi1_0");  // sorted
   // A name never becomes a path outside the search path.
   EXPECT_FALSE(LoadPlanner("..", Options()).ok());
 }
@@ -274,6 +274,119 @@ TEST(PluginHost, QueriesReachThePluginUnchanged) {
   EXPECT_EQ(result->log[0].message, "probe done");
 }
 
+// The fake world with the sealed pocket's wall voxels as the chair's (instance 3), its robot 1
+// some way into a run, and an arm-mounted reconstructor.
+class ChairWorld : public test::FakeWorld {
+ public:
+  ChairWorld() {
+    PlannerRobot& r1 = robots()[1];
+    r1.distance_m = 2.5f;
+    r1.busy_s = 10.f;
+    r1.idle_s = 4.f;
+    ScanMode& arm = r1.modes[1];
+    arm.mount = CameraMount::kArm;
+    arm.camera_height_min_m = 0.4f;
+    arm.camera_height_max_m = 1.5f;
+    arm.reach_max_m = 0.8f;
+    arm.capture_hz = 2.f;
+    arm.switch_s = 2.f;
+  }
+  static bool OnChair(const SurfaceVoxel& v) {
+    return v.position.x() > 0.5f && v.position.x() < 1.75f && v.position.y() > 1.5f &&
+           v.position.y() < 2.75f;
+  }
+  std::vector<SurfaceVoxel> SurfaceVoxels() const override {
+    std::vector<SurfaceVoxel> v = FakeWorld::SurfaceVoxels();
+    for (SurfaceVoxel& s : v) s.instance = OnChair(s) ? 3 : -1;
+    return v;
+  }
+};
+
+TEST(PluginHost, Abi11FieldsAndExtensionsReachThePlugin) {
+  ChairWorld world;
+  auto planner = MustLoad("probe");
+  ASSERT_TRUE(planner);
+  auto result = planner->Plan(world, PlanRequest{});
+  ASSERT_TRUE(result.ok()) << result.status().message();
+  const auto d = Diagnostics(*result);
+  EXPECT_FLOAT_EQ(float(d.at("robot1_distance_m")), 2.5f);
+  EXPECT_FLOAT_EQ(float(d.at("robot1_busy_s")), 10.f);
+  EXPECT_FLOAT_EQ(float(d.at("robot1_idle_s")), 4.f);
+  EXPECT_EQ(d.at("reconstructor_mount"), VP_MOUNT_ARM);
+  EXPECT_FLOAT_EQ(float(d.at("reconstructor_height_max_m")), 1.5f);
+  EXPECT_FLOAT_EQ(float(d.at("reconstructor_reach_max_m")), 0.8f);
+  EXPECT_FLOAT_EQ(float(d.at("reconstructor_capture_hz")), 2.f);
+  EXPECT_FLOAT_EQ(float(d.at("reconstructor_switch_s")), 2.f);
+  EXPECT_EQ(d.at("ext_objects_1"), 1.0);
+  EXPECT_EQ(d.at("ext_objects_2"), 0.0);
+  EXPECT_EQ(d.at("ext_unknown"), 0.0);
+  EXPECT_EQ(d.at("ext_null_name"), 0.0);
+  // vp.objects: exactly the chair's voxels, in the world's order.
+  std::vector<SurfaceVoxel> chair;
+  for (const SurfaceVoxel& v : world.SurfaceVoxels()) {
+    if (ChairWorld::OnChair(v)) chair.push_back(v);
+  }
+  ASSERT_GT(chair.size(), 4u);
+  EXPECT_EQ(d.at("chair_voxels"), double(chair.size()));
+  EXPECT_EQ(d.at("chair_voxels_all_its_own"), 1.0);
+  EXPECT_FLOAT_EQ(float(d.at("chair_first_x")), chair[0].position.x());
+  EXPECT_EQ(d.at("absent_voxels"), 0.0);
+}
+
+TEST(PluginHost, APluginBuiltAgainstAbi10LoadsAndPlans) {
+  test::FakeWorld world;
+  auto planner = MustLoad("abi1_0");
+  ASSERT_TRUE(planner);
+  auto result = planner->Plan(world, PlanRequest{});
+  ASSERT_TRUE(result.ok()) << result.status().message();
+  const auto d = Diagnostics(*result);
+  // It sees a larger host table than its own and gets the 1.0 prefix of the grown structs:
+  // vp_robot grew by 3 floats, vp_mode_params by 12 four-byte fields.
+  EXPECT_EQ(d.at("host_table_size"), double(sizeof(vp_host_api)));
+  EXPECT_EQ(d.at("robot_size_asked"), double(sizeof(vp_robot) - 3 * sizeof(float)));
+  EXPECT_EQ(d.at("robot_size_written"), d.at("robot_size_asked"));
+  EXPECT_EQ(d.at("mode_size_asked"), double(sizeof(vp_mode_params) - 12 * sizeof(float)));
+  EXPECT_EQ(d.at("mode_size_written"), d.at("mode_size_asked"));
+  const PlannerRobot r0 = world.Robots()[0];  // Robots() returns a copy
+  EXPECT_FLOAT_EQ(float(d.at("robot0_x")), r0.position_m.x());
+  EXPECT_FLOAT_EQ(float(d.at("robot0_pitch_rate")), r0.camera_pitch_rate_radps);
+  EXPECT_FLOAT_EQ(float(d.at("reconstructor_cy")), r0.modes[1].cy);
+  // Its task passed validation and reached the plan.
+  ASSERT_EQ(result->robots.size(), 2u);
+  ASSERT_EQ(result->robots[0].tasks.size(), 1u);
+  EXPECT_EQ(result->robots[0].tasks[0].tag, 7u);
+  EXPECT_FLOAT_EQ(result->robots[0].tasks[0].position_m.x(), r0.position_m.x());
+}
+
+TEST(PluginCppLayer, AMissingOrShortExtensionIsAClearError) {
+  // A host table whose get_extension has nothing, then one whose vp.objects table is too short
+  // for the struct the plugin was built with.
+  vp_host_api host = PlannerHostApi();
+  host.get_call_info = [](const vp_world*, vp_call_info*) -> vp_status { return VP_OK; };
+  host.get_extension = [](const char*, uint32_t) -> const vp_extension_header* { return nullptr; };
+  const vp_world* no_world = nullptr;
+  const vp::WorldView view(&host, no_world);
+  EXPECT_EQ(view.Extension<vp_objects_ext>(VP_EXT_OBJECTS, 1), nullptr);
+  try {
+    (void)view.InstanceSurface(3);
+    ADD_FAILURE() << "no vp.objects: InstanceSurface must throw";
+  } catch (const vp::Error& e) {
+    EXPECT_EQ(e.status(), VP_ERROR_NOT_AVAILABLE);
+    EXPECT_TRUE(Contains(e.what(), "vp.objects version 1")) << e.what();
+  }
+  host.get_extension = [](const char*, uint32_t) -> const vp_extension_header* {
+    static const vp_extension_header kShort = {sizeof(vp_extension_header), 1};
+    return &kShort;
+  };
+  const vp::WorldView short_view(&host, no_world);
+  EXPECT_EQ(short_view.Extension<vp_objects_ext>(VP_EXT_OBJECTS, 1), nullptr);
+  // The real host's table is whole.
+  const vp_extension_header* real = PlannerHostApi().get_extension(VP_EXT_OBJECTS, 1);
+  ASSERT_NE(real, nullptr);
+  EXPECT_EQ(real->struct_size, sizeof(vp_objects_ext));
+  EXPECT_EQ(real->version, 1u);
+}
+
 TEST(PluginHost, DeterministicForASeed) {
   const test::FakeWorld world;
   const std::string config = R"({"candidates": 6})";
@@ -334,6 +447,9 @@ TEST(PluginCppLayer, EntryRefusesAnotherHostAbiOrAShortHostTable) {
   vp_host_api short_host = PlannerHostApi();
   short_host.struct_size = sizeof(vp_host_api) - sizeof(void*);
   EXPECT_EQ(vp::detail::Entry<Nothing>(1, &short_host, &api, "n", "1"), VP_ERROR_STRUCT_SIZE);
+  // That is a 1.0 host: a plugin that also supports those tests for get_extension first.
+  EXPECT_FALSE(VP_HOST_HAS(&short_host, get_extension));
+  EXPECT_TRUE(VP_HOST_HAS(&PlannerHostApi(), get_extension));
   // An older host with a shorter planner table gets only the prefix it asked for.
   vp_planner_api prefix{};
   prefix.struct_size = offsetof(vp_planner_api, create);

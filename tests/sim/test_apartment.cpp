@@ -248,7 +248,8 @@ TEST_P(ApartmentValidity, ClosedReachableClear) {
 
 INSTANTIATE_TEST_SUITE_P(Seeds, ApartmentValidity,
                          ::testing::Combine(::testing::Values(ApartmentSize::kS, ApartmentSize::kM,
-                                                              ApartmentSize::kL),
+                                                              ApartmentSize::kL,
+                                                              ApartmentSize::kXL),
                                             ::testing::Range(0, 8)));
 
 TEST(Apartment, ParametricOnlyWithoutIndex) {
@@ -316,7 +317,8 @@ TEST(Apartment, WrittenWorldLoadsBack) {
 }
 
 TEST(Apartment, RefusesBadInput) {
-  EXPECT_FALSE(ParseApartmentSize("XL").ok());
+  EXPECT_FALSE(ParseApartmentSize("XXL").ok());
+  EXPECT_EQ(*ParseApartmentSize("xl"), ApartmentSize::kXL);
   EXPECT_TRUE(ParseApartmentSize("m").ok());
   ApartmentParams p;
   p.furniture_index = "/nonexistent/aws_furniture_index.tsv";

@@ -65,7 +65,7 @@ TEST(SimSceneCli, UsageErrorsExitTwoAndWriteNothing) {
       (test::SharedDataDir() / "scenes/aws_small_house/derived/small_house_visual.ply").string();
   const std::string out = (dir / "out").string();
   const std::vector<std::vector<std::string>> cases = {
-      {"sim", "scene", "--generate", "apartment", "--size", "XL", "--out", out},
+      {"sim", "scene", "--generate", "apartment", "--size", "XXL", "--out", out},
       {"sim", "scene", "--generate", "house", "--out", out},
       {"sim", "scene", "--out", out},
       {"sim", "scene", "--generate", "apartment", "--scene", scene, "--out", out},

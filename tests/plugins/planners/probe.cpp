@@ -1,5 +1,6 @@
 // Reads every query of the host table once and reports what it saw as diagnostics, so the test
 // can compare the C view with the PlannerWorld behind it.
+#include <algorithm>
 #include <cmath>
 #include <string>
 
@@ -57,6 +58,28 @@ class Probe : public vp::Planner {
     out.Diagnostic("robot1_modes", r1.mode_count);
     out.Diagnostic("robot1_queue_tag", world.Queue(1).empty() ? -1.0 : world.Queue(1)[0].tag);
     out.Diagnostic("reconstructor_speed", world.Mode(1, VP_MODE_RECONSTRUCTOR).max_speed_mps);
+    // 1.1's appended fields.
+    out.Diagnostic("robot1_distance_m", r1.distance_m);
+    out.Diagnostic("robot1_busy_s", r1.busy_s);
+    out.Diagnostic("robot1_idle_s", r1.idle_s);
+    const vp_mode_params arm = world.Mode(1, VP_MODE_RECONSTRUCTOR);
+    out.Diagnostic("reconstructor_mount", arm.mount);
+    out.Diagnostic("reconstructor_height_max_m", arm.camera_height_max_m);
+    out.Diagnostic("reconstructor_reach_max_m", arm.reach_max_m);
+    out.Diagnostic("reconstructor_capture_hz", arm.capture_hz);
+    out.Diagnostic("reconstructor_switch_s", arm.switch_s);
+    // Extensions: vp.objects 1 is there, a later version and an unknown name are not.
+    out.Diagnostic("ext_objects_1", world.Extension<vp_objects_ext>(VP_EXT_OBJECTS, 1) != nullptr);
+    out.Diagnostic("ext_objects_2", world.Extension<vp_objects_ext>(VP_EXT_OBJECTS, 2) != nullptr);
+    out.Diagnostic("ext_unknown", world.host()->get_extension("vp.unknown", 1) != nullptr);
+    out.Diagnostic("ext_null_name", world.host()->get_extension(nullptr, 1) != nullptr);
+    const auto chair = world.InstanceSurface(3);
+    out.Diagnostic("chair_voxels", double(chair.size()));
+    out.Diagnostic("chair_voxels_all_its_own",
+                   std::all_of(chair.begin(), chair.end(),
+                               [](const vp_surface_voxel& v) { return v.instance == 3; }));
+    out.Diagnostic("chair_first_x", chair.empty() ? -1.0 : chair[0].position[0]);
+    out.Diagnostic("absent_voxels", double(world.InstanceSurface(4000000000u).size()));
     const float xy[4] = {r1.x_m, r1.y_m, world.Robot(0).x_m, world.Robot(0).y_m};
     const auto d = world.DistanceMatrix(xy, r1.radius_m);
     out.Diagnostic("d01", d[1]);
