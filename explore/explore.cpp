@@ -60,7 +60,8 @@ struct RobotRun {
   double trajectory_t0_s = 0.0;
   double t_s = 0.0;  // this robot's time on the run clock (its Robot clock plus waiting)
   bool idle = false;
-  double idle_s = 0.0;  // of t_s, with an empty queue
+  double next_capture_s = 0.0;  // time-based capture (ModeParams::capture_hz): the next frame
+  double idle_s = 0.0;          // of t_s, with an empty queue
   uint64_t frames = 0;
   RobotTrack track;
   std::vector<PlannerTask> views;
@@ -136,7 +137,14 @@ class Explorer {
 
 Status Explorer::Fuse(RobotRun& r, bool force) {
   const Pose3f T_W_C = r.robot.T_W_C();
-  if (!r.trigger.ShouldFuse(T_W_C) && !force) return Status::Ok();
+  const float capture_hz = r.robot.mode_params().capture_hz;
+  if (capture_hz > 0.f) {
+    // On the run clock: a frame once a period has passed since the last, whatever moved.
+    if (!force && r.t_s + 1e-9 < r.next_capture_s) return Status::Ok();
+    r.next_capture_s = r.t_s + 1.0 / double(capture_hz);
+  } else if (!r.trigger.ShouldFuse(T_W_C) && !force) {
+    return Status::Ok();
+  }
   const PinholeCamera camera = r.robot.camera();
   RenderParams rp;
   // Clearing needs the readings beyond the range: the sensor returns them, unlimited here.
@@ -348,10 +356,16 @@ Status Explorer::StepToView(RobotRun& r, QueuedTask& q) {
     return AfterPrimitive(r, c);
   }
   r.robot.WrapCameraYaw();
-  // Dwell at the view: the task's time, at least the robot's capture time.
-  r.t_s += std::max(double(q.task.dwell_s), double(r.robot.params().dwell_s));
-  Sample(r, RobotStatus::kBusy);
-  VOXPLAN_RETURN_IF_ERROR(Fuse(r, true));
+  // Dwell at the view: the task's time, at least the robot's capture time. With time-based
+  // capture the dwell yields floor(dwell x rate) frames (at least one), spread over it.
+  const double dwell_s = std::max(double(q.task.dwell_s), double(r.robot.params().dwell_s));
+  const float capture_hz = r.robot.mode_params().capture_hz;
+  const int frames = capture_hz > 0.f ? std::max(1, int(std::floor(dwell_s * capture_hz))) : 1;
+  for (int k = 0; k < frames; ++k) {
+    r.t_s += dwell_s / frames;
+    Sample(r, RobotStatus::kBusy);
+    VOXPLAN_RETURN_IF_ERROR(Fuse(r, true));
+  }
   if (q.task.tag != kPathOnlyTag) r.views.push_back(q.task);
   r.queue.pop_front();
   r.routed = false;
@@ -493,8 +507,9 @@ std::vector<PlannerRobot> Explorer::Snapshot() const {
       sm.fy = cam.fy;
       sm.cx = cam.cx;
       sm.cy = cam.cy;
-      // Today's robot: one head camera for both modes, captured by displacement, switched free.
+      // Today's robot: one head camera for both modes, switched free.
       sm.mount = CameraMount::kHead;
+      sm.capture_hz = mp.capture_hz;
       sm.camera_height_min_m = sm.camera_height_max_m = rp.camera_height_m;
       sm.min_pitch_rad = pr.min_pitch_rad;
       sm.max_pitch_rad = pr.max_pitch_rad;

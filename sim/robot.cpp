@@ -33,6 +33,9 @@ Status ValidateMode(const ModeParams& m, const char* name) {
                            " horizontal_fov_deg must be in (1, 179)");
   if (!(m.max_range_m > 0.f))
     return InvalidArgument(std::string("RobotParams: ") + name + " max_range_m must be > 0");
+  if (!(m.capture_hz >= 0.f && m.capture_hz <= kMaxCaptureHz))
+    return InvalidArgument(std::string("RobotParams: ") + name + " capture_hz must be in [0, " +
+                           std::to_string(int(kMaxCaptureHz)) + "]");
   return Status::Ok();
 }
 

@@ -28,7 +28,12 @@ struct ModeParams {
   float max_turn_rate_radps = 1.0f;  // base, turning in place
   float horizontal_fov_deg = 90.0f;
   float max_range_m = 5.0f;
+  // Frames per second on the run clock, while driving, turning and dwelling (a slow, close scan
+  // gathers more); 0: captured by displacement (FusionTrigger) and once per view. At most
+  // kMaxCaptureHz.
+  float capture_hz = 0.0f;
 };
+inline constexpr float kMaxCaptureHz = 60.0f;
 ModeParams DefaultModeParams(RobotMode mode);
 
 struct RobotParams {

@@ -54,6 +54,7 @@ struct ExploreOptions {
   bool no_color = false;
   bool no_clear = false;
   double fuse_step_m = 0.25, fuse_step_deg = 15.0;
+  double capture_hz = 0.0;  // both modes; 0: the displacement trigger
   int threads = 0;
   MemoryBudgetOptions memory;
   PlannerLimits limits;  // --planner-hard-limit, --planner-hard-limit-min
@@ -91,6 +92,10 @@ int CheckUsage(const ExploreOptions& o, std::vector<Eigen::Vector2f>* starts) {
   if (!(o.limits.min_s > 0.0 && std::isfinite(o.limits.min_s)))
     return Fail("--planner-hard-limit-min must be a finite number of seconds > 0, got " +
                     Num(o.limits.min_s),
+                kExitUsage);
+  if (!(o.capture_hz >= 0.0 && o.capture_hz <= kMaxCaptureHz))
+    return Fail("--capture-hz must be 0 (capture by displacement) or a rate up to " +
+                    Num(kMaxCaptureHz) + " frames per second, got " + Num(o.capture_hz),
                 kExitUsage);
   if (!(o.max_range_m > kMinRangeM && o.max_range_m <= bounds::kDepthMaxM))
     return Fail("--max-range-m must be a finite number of metres above " + Num(kMinRangeM) +
@@ -164,6 +169,7 @@ ExploreRunParams RunParams(const ExploreOptions& o, std::vector<Eigen::Vector2f>
   params.trigger = {float(o.fuse_step_m), float(o.fuse_step_deg)};
   params.robot.explorer.horizontal_fov_deg = float(o.fov_deg);
   params.robot.explorer.max_range_m = float(o.max_range_m);
+  params.robot.explorer.capture_hz = params.robot.reconstructor.capture_hz = float(o.capture_hz);
   return run;
 }
 
@@ -293,6 +299,10 @@ Command AddExploreCommand(CLI::App& app) {
            "Ground-truth samples per m² for completeness and accuracy");
   positive("--fuse-step", o->fuse_step_m, "Metres of camera travel between fused frames");
   positive("--fuse-step-deg", o->fuse_step_deg, "Degrees of camera turn between fused frames");
+  sub->add_option("--capture-hz", o->capture_hz,
+                  "Frames per second on the run clock, in both modes, while driving and dwelling "
+                  "(a view's dwell gives floor(dwell x rate) frames); 0: by --fuse-step")
+      ->capture_default_str();
   positive("--progress-interval", run.explore.progress_interval_s,
            "Simulated seconds between progress lines on stderr");
   sub->add_option("--threads", o->threads, "Worker threads (0: all)")->check(ThreadCount());

@@ -177,6 +177,26 @@ TEST(Explore, SameSeedGivesTheSameRun) {
     EXPECT_EQ(a->series[i].coverage, b->series[i].coverage);
 }
 
+// Time-based capture (ModeParams::capture_hz): the faster the camera runs, the more frames the
+// same 40 s fuse; dwells give several frames at one pose. Rates past the bound are refused.
+TEST(Explore, TimeBasedCaptureFusesMoreFramesTheFasterItRuns) {
+  ExploreParams params = FastParams();
+  params.max_time_s = 40.0;
+  std::vector<size_t> frames;
+  for (float hz : {1.f, 4.f, 20.f}) {
+    params.robot.explorer.capture_hz = params.robot.reconstructor.capture_hz = hz;
+    Result<ExploreResult> run = RunGreedy(params, 1);
+    ASSERT_TRUE(run.ok()) << run.status().message();
+    frames.push_back(run->frames_fused);
+  }
+  EXPECT_LT(frames[0], frames[1]);
+  EXPECT_LT(frames[1], frames[2]);
+  for (float bad : {-1.f, kMaxCaptureHz + 1.f, std::nanf("")}) {
+    params.robot.reconstructor.capture_hz = bad;
+    EXPECT_FALSE(params.Validate().ok()) << bad;
+  }
+}
+
 TEST(Explore, ColourOffLeavesTheRunAndTheGeometryUnchanged) {
   // fuse_color only saves work: the robots, the frames and the fused surface stay the same.
   ExploreParams params = FastParams();

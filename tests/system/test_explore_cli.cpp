@@ -100,7 +100,11 @@ TEST(ExploreCli, RefusesACameraItCannotSimulate) {
            {"--fov-deg", "180", "--fov-deg must lie strictly between 1 and 179"},
            {"--fov-deg", "nan", "--fov-deg must lie"},
            {"--max-range-m", "0.05", "--max-range-m must be a finite number of metres above 0.1"},
-           {"--max-range-m", "inf", "--max-range-m must be"}}) {
+           {"--max-range-m", "inf", "--max-range-m must be"},
+           {"--capture-hz", "-1",
+            "--capture-hz must be 0 (capture by displacement) or a rate up to 60"},
+           {"--capture-hz", "61", "--capture-hz must be"},
+           {"--capture-hz", "nan", "--capture-hz must be"}}) {
     const RunResult r = RunCli({"explore", "--scene", "apartment:size=S,seed=1", "--planner",
                                 "greedy", option, value, "--out", (dir / "out").string()});
     EXPECT_EQ(r.exit_code, 2) << Describe(r);
