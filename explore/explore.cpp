@@ -12,6 +12,7 @@
 #include "core/bounds.h"
 #include "core/queries.h"
 #include "explore/explore_world.h"
+#include "fusion/integrate.h"
 #include "planning/integrate_planning.h"
 #include "sim/raycaster.h"
 #include "sim/sensor_noise.h"
@@ -85,6 +86,11 @@ class Explorer {
         progress_(progress),
         volume_(std::make_unique<TsdfVolume>(VolumeParams{
             params.voxel_size_m, params.trunc_vox * params.voxel_size_m, params.max_memory_bytes})),
+        recon_(params.recon_voxel_size_m > 0.f
+                   ? std::make_unique<TsdfVolume>(VolumeParams{
+                         params.recon_voxel_size_m, params.trunc_vox * params.recon_voxel_size_m,
+                         params.max_memory_bytes})
+                   : nullptr),
         map_(*volume_),
         floor_(std::make_unique<FloorMap>(params.voxel_size_m, params.floor)),
         explore_world_(map_, *floor_, ExploreWorldParams{}) {}
@@ -120,6 +126,7 @@ class Explorer {
   ExploreProgressFn progress_;
   std::unique_ptr<MeshRaycaster> raycaster_;
   std::unique_ptr<TsdfVolume> volume_;
+  std::unique_ptr<TsdfVolume> recon_;  // ExploreParams::recon_voxel_size_m > 0
   PlanningMap map_;
   std::unique_ptr<FloorMap> floor_;
   ExploreWorld explore_world_;
@@ -178,6 +185,11 @@ Status Explorer::Fuse(RobotRun& r, bool force) {
   result_.timings.fuse_ms += NowMs() - t0;
   if (!stats.ok()) return stats.status();
   result_.blocks_dropped += stats->integrate.blocks_refused;
+  if (recon_) {  // the same frame into the finer volume, for the mesh alone
+    Result<IntegrateStats> fine = IntegrateFrame(out.depth, out.color, camera, T_W_C, ip, *recon_);
+    if (!fine.ok()) return fine.status();
+    result_.blocks_dropped += fine->blocks_refused;
+  }
   touched_.insert(touched_.end(), stats->integrate.touched_blocks.begin(),
                   stats->integrate.touched_blocks.end());
   ++r.frames;
@@ -768,6 +780,7 @@ Result<ExploreResult> Explorer::Run(const std::vector<Eigen::Vector2f>& starts) 
   }
   result_.timings.total_ms = NowMs() - run_t0;
   result_.volume = std::move(volume_);
+  result_.recon_volume = std::move(recon_);
   result_.floor = std::move(floor_);
   return std::move(result_);
 }
@@ -777,6 +790,10 @@ Result<ExploreResult> Explorer::Run(const std::vector<Eigen::Vector2f>& starts) 
 Status ExploreParams::Validate() const {
   const VolumeParams volume{voxel_size_m, trunc_vox * voxel_size_m, max_memory_bytes};
   VOXPLAN_RETURN_IF_ERROR(volume.Validate().WithContext("explore"));
+  if (recon_voxel_size_m != 0.f) {
+    const VolumeParams recon{recon_voxel_size_m, trunc_vox * recon_voxel_size_m, max_memory_bytes};
+    VOXPLAN_RETURN_IF_ERROR(recon.Validate().WithContext("explore: reconstruction volume"));
+  }
   VOXPLAN_RETURN_IF_ERROR(bounds::CheckImageSize("explore: image size", image_width, image_height));
   if (!(step_s > 0.0)) return InvalidArgument("explore: step_s must be > 0");
   if (!(planning_interval_s > 0.0))

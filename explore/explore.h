@@ -51,8 +51,11 @@ struct ExploreParams {
   float trunc_vox = 3.0f;
   int image_width = 320, image_height = 240;  // 5 cm voxels need no more
   uint64_t max_memory_bytes = 0;              // the fused map's budget (VolumeParams); 0: none
-  bool noise = true;                          // Kinect noise on the rendered depth
-  bool fuse_labels = true;                    // instance labels into the object map
+  // > 0: a second, finer TSDF (e.g. 0.02 m, trunc_vox voxels) fused with the same frames, for
+  // the final mesh and its metrics; the planners keep voxel_size_m. Its own max_memory_bytes.
+  float recon_voxel_size_m = 0.f;
+  bool noise = true;        // Kinect noise on the rendered depth
+  bool fuse_labels = true;  // instance labels into the object map
   // Vertex colours of the final mesh only (no metric reads them): off saves rendering and
   // fusing colour, about a tenth of a frame's cost.
   bool fuse_color = true;
@@ -151,6 +154,7 @@ struct ExploreResult {
   ExploreTimings timings;
   // The maps at the end.
   std::unique_ptr<TsdfVolume> volume;
+  std::unique_ptr<TsdfVolume> recon_volume;  // with recon_voxel_size_m > 0, else null
   std::unique_ptr<FloorMap> floor;
 };
 

@@ -93,7 +93,9 @@ Result<std::vector<Eigen::Vector3f>> ProbePoints(const Mesh& ground_truth,
 Status Evaluate(const ExploreRunParams& params, const World& world, const FloorPlan& plan,
                 const PointSetFilter& filter, ExploreRunReport& report) {
   const Stopwatch eval_clock;
-  report.mesh = ExtractMesh(*report.loop.volume);
+  // The finer reconstruction volume when the run kept one, else the planning map.
+  report.mesh =
+      ExtractMesh(report.loop.recon_volume ? *report.loop.recon_volume : *report.loop.volume);
   VOXPLAN_RETURN_IF_ERROR(WriteRunMesh(report.mesh, params.out_dir));
   MeshEvalParams ep;
   ep.threshold_m = 0.05f;

@@ -74,6 +74,9 @@ json MetricsObject(const ExploreRunParams& params, const ExploreRunReport& repor
           : "whole ground-truth surface, samples within 5 cm of the final mesh";
   m["accuracy_rms_m"] = RoundTo(quality.accuracy_rms_m, 4);
   m["accuracy_mean_m"] = RoundTo(quality.accuracy_mean_m, 4);
+  // Only with the option, so runs without it keep their bytes: what the mesh was fused at.
+  if (params.explore.recon_voxel_size_m > 0.f)
+    m["mesh_voxel_size_m"] = RoundTo(params.explore.recon_voxel_size_m, 4);
   json per_robot = json::array();
   for (const RobotRunMetrics& rm : metrics.robots) per_robot.push_back(RoundTo(rm.distance_m, 3));
   m["distance_per_robot_m"] = per_robot;

@@ -46,6 +46,7 @@ struct ExploreOptions {
   std::string planner_config;
   std::string start;
   double voxel_size = 0.05;
+  double recon_voxel_size = 0.0;  // 0: the mesh comes from the planning map
   // The explorer camera (the mode every planner drives in); defaults are ModeParams' own.
   double fov_deg = DefaultModeParams(RobotMode::kExplorer).horizontal_fov_deg;
   double max_range_m = DefaultModeParams(RobotMode::kExplorer).max_range_m;
@@ -92,6 +93,11 @@ int CheckUsage(const ExploreOptions& o, std::vector<Eigen::Vector2f>* starts) {
   if (!(o.limits.min_s > 0.0 && std::isfinite(o.limits.min_s)))
     return Fail("--planner-hard-limit-min must be a finite number of seconds > 0, got " +
                     Num(o.limits.min_s),
+                kExitUsage);
+  if (!(o.recon_voxel_size == 0.0 || (o.recon_voxel_size >= bounds::kVoxelSizeMinM &&
+                                      o.recon_voxel_size <= bounds::kVoxelSizeMaxM)))
+    return Fail("--recon-voxel-size must be 0 (none) or between " + Num(bounds::kVoxelSizeMinM) +
+                    " and " + Num(bounds::kVoxelSizeMaxM) + " m, got " + Num(o.recon_voxel_size),
                 kExitUsage);
   if (!(o.capture_hz >= 0.0 && o.capture_hz <= kMaxCaptureHz))
     return Fail("--capture-hz must be 0 (capture by displacement) or a rate up to " +
@@ -161,6 +167,7 @@ ExploreRunParams RunParams(const ExploreOptions& o, std::vector<Eigen::Vector2f>
   run.starts = std::move(starts);
   ExploreParams& params = run.explore;
   params.voxel_size_m = float(o.voxel_size);
+  params.recon_voxel_size_m = float(o.recon_voxel_size);
   params.max_memory_bytes = MemoryBudgetBytes(o.memory);
   params.noise = !o.no_noise;
   params.fuse_labels = !o.no_labels;
@@ -263,6 +270,10 @@ Command AddExploreCommand(CLI::App& app) {
   sub->add_option("--out,-o", run.out_dir, "Output folder (created)")->required();
   sub->add_option("--voxel-size", o->voxel_size, "Voxel size of the fused map, metres")
       ->check(VoxelSize())
+      ->capture_default_str();
+  sub->add_option("--recon-voxel-size", o->recon_voxel_size,
+                  "Voxel size of a second, finer map fused with the same frames for mesh.ply and "
+                  "the mesh metrics (e.g. 0.02); 0: the mesh comes from the planning map")
       ->capture_default_str();
   sub->add_option("--width", run.explore.image_width, "Rendered image width, pixels")
       ->check(ImageSide())

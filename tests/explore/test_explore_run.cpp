@@ -143,6 +143,43 @@ TEST(ExploreRun, AMapAtItsMemoryBudgetWarnsAndCountsWhatItDropped) {
   EXPECT_EQ(m["blocks_dropped_memory"], report->loop.blocks_dropped);
 }
 
+// --recon-voxel-size: the mesh (and its metrics) come from a finer volume fused with the same
+// frames; the planning map, the planner's view and the run itself stay as they were.
+TEST(ExploreRun, AFinerReconstructionVolumeMakesTheMeshAndLeavesTheRunAlone) {
+  std::unique_ptr<LoadedPlanner> planner = Greedy();
+  ASSERT_NE(planner, nullptr);
+  test::TempDir dir("explore_run");
+  ExploreRunParams coarse = ShortRun(dir / "coarse");
+  coarse.explore.max_time_s = 20.0;
+  coarse.explore.noise = false;  // so both meshes see the same depth
+  ExploreRunParams fine = coarse;
+  fine.out_dir = (dir / "fine").string();
+  fine.explore.recon_voxel_size_m = 0.05f;  // half the planning map's 0.1 m
+  Result<ExploreRunReport> a = RunExploreExperiment(coarse, *planner);
+  std::unique_ptr<LoadedPlanner> planner2 = Greedy();
+  Result<ExploreRunReport> b = RunExploreExperiment(fine, *planner2);
+  ASSERT_TRUE(a.ok() && b.ok());
+  EXPECT_EQ(a->loop.recon_volume, nullptr);
+  ASSERT_NE(b->loop.recon_volume, nullptr);
+  EXPECT_FLOAT_EQ(b->loop.recon_volume->params().voxel_size_m, 0.05f);
+  // The run is the same: same frames, same tracks, same planning map.
+  EXPECT_EQ(a->loop.frames_fused, b->loop.frames_fused);
+  EXPECT_EQ(a->loop.volume->num_blocks(), b->loop.volume->num_blocks());
+  ASSERT_EQ(a->loop.tracks.size(), b->loop.tracks.size());
+  EXPECT_EQ(a->loop.tracks[0].samples.size(), b->loop.tracks[0].samples.size());
+  // The mesh is the finer one's: more triangles, closer to the true surface.
+  EXPECT_GT(b->mesh.num_triangles(), 2 * a->mesh.num_triangles());
+  EXPECT_LT(b->quality.accuracy_rms_m, a->quality.accuracy_rms_m);
+  std::ifstream metrics_file(dir / "fine" / "metrics.json");
+  const nlohmann::json m = nlohmann::json::parse(metrics_file);
+  EXPECT_FLOAT_EQ(m["mesh_voxel_size_m"].get<float>(), 0.05f);
+  std::ifstream coarse_metrics(dir / "coarse" / "metrics.json");
+  EXPECT_FALSE(nlohmann::json::parse(coarse_metrics).contains("mesh_voxel_size_m"));
+  ExploreParams bad = fine.explore;
+  bad.recon_voxel_size_m = -1.f;
+  EXPECT_FALSE(bad.Validate().ok());
+}
+
 TEST(ExploreRun, RefusesABadRequestBeforeTheOutputFolderExists) {
   test::TempDir dir("explore_run_refused");
   std::unique_ptr<LoadedPlanner> planner = Greedy();

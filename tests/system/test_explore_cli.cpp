@@ -104,7 +104,9 @@ TEST(ExploreCli, RefusesACameraItCannotSimulate) {
            {"--capture-hz", "-1",
             "--capture-hz must be 0 (capture by displacement) or a rate up to 60"},
            {"--capture-hz", "61", "--capture-hz must be"},
-           {"--capture-hz", "nan", "--capture-hz must be"}}) {
+           {"--capture-hz", "nan", "--capture-hz must be"},
+           {"--recon-voxel-size", "-0.02", "--recon-voxel-size must be 0 (none) or between"},
+           {"--recon-voxel-size", "nan", "--recon-voxel-size must be"}}) {
     const RunResult r = RunCli({"explore", "--scene", "apartment:size=S,seed=1", "--planner",
                                 "greedy", option, value, "--out", (dir / "out").string()});
     EXPECT_EQ(r.exit_code, 2) << Describe(r);
