@@ -221,8 +221,12 @@ Result<RunMetrics> EvaluateRun(const std::vector<RobotTrack>& tracks, const RunE
       if (!a.mode.empty()) {
         robot.mode_time_s[a.mode] += dt_s;
         robot.mode_distance_m[a.mode] += step_m;
+        if (!b.mode.empty() && b.mode != a.mode) ++robot.mode_switches;
       }
     }
+    for (const auto& [mode, t] : robot.mode_time_s) run.mode_time_s[mode] += t;
+    for (const auto& [mode, d] : robot.mode_distance_m) run.mode_distance_m[mode] += d;
+    run.mode_switches += robot.mode_switches;
     robot.idle_time_s = run.time_s - robot.busy_time_s;
     robot.idle_fraction = run.time_s > 0.0 ? robot.idle_time_s / run.time_s : 0.0;
     run.distance_total_m += robot.distance_m;

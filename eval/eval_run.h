@@ -66,6 +66,8 @@ struct RobotRunMetrics {
   // Per non-empty mode: time (within the robot's log span) and distance in that mode.
   std::map<std::string, double> mode_time_s;
   std::map<std::string, double> mode_distance_m;
+  // Times the mode changed between two samples that both name one (Guo 2022's switches).
+  size_t mode_switches = 0;
 };
 
 struct RunMetrics {
@@ -78,6 +80,10 @@ struct RunMetrics {
   double load_balance_cov = 0.0;   // D-LB; 0 for one robot or when nobody moved
   double idle_time_total_s = 0.0;
   double time_load_balance = 0.0;  // T-LB: idle_time_total_s / (robots * time_s)
+  // Summed over the robots: per mode, and the switches.
+  std::map<std::string, double> mode_time_s;
+  std::map<std::string, double> mode_distance_m;
+  size_t mode_switches = 0;
 };
 
 struct RunEvalParams {

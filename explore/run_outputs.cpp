@@ -87,6 +87,13 @@ json MetricsObject(const ExploreRunParams& params, const ExploreRunReport& repor
   m["time_s"] = RoundTo(r.time_s, 2);
   m["idle_time_s"] = RoundTo(metrics.idle_time_total_s, 2);
   m["time_load_balance"] = RoundTo(metrics.time_load_balance, 4);
+  // Per scanning mode over all robots (Guo 2022's mode split), and how often a robot switched.
+  json mode_time = json::object(), mode_distance = json::object();
+  for (const auto& [mode, t] : metrics.mode_time_s) mode_time[mode] = RoundTo(t, 2);
+  for (const auto& [mode, d] : metrics.mode_distance_m) mode_distance[mode] = RoundTo(d, 3);
+  m["mode_time_s"] = mode_time;
+  m["mode_distance_m"] = mode_distance;
+  m["mode_switches"] = metrics.mode_switches;
   m["coverage"] = r.series.empty() ? 0.0 : RoundTo(r.series.back().coverage, 4);
   m["plan_calls"] = r.plan_calls.size();
   m["plan_ms_median"] = RoundTo(plan_summary.median, 3);  // wall time: varies run to run

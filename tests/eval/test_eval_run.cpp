@@ -60,6 +60,26 @@ TEST(EvaluateRun, StraightTracksGiveExactDistancesBalanceAndIdleTime) {
   EXPECT_NEAR(run->robots[0].mode_distance_m.at("explorer"), 10.0, kExact);
   EXPECT_TRUE(run->robots[1].mode_time_s.empty());
   EXPECT_EQ(run->robots[1].samples, 11u);
+  EXPECT_EQ(run->mode_switches, 0u);
+  EXPECT_NEAR(run->mode_time_s.at("explorer"), 10.0, kExact);
+}
+
+TEST(EvaluateRun, ModeTimesDistancesAndSwitchesAddUpOverRobots) {
+  std::vector<RobotTrack> tracks = TwoRobots();
+  // r0: explorer 0-4 s, reconstructor 4-7 s, explorer again 7-10 s: two switches.
+  for (int t = 4; t < 7; ++t) tracks[0].samples[size_t(t)].mode = "reconstructor";
+  // r1: reconstructor throughout, one robot-second of it driving per sample up to 4 s.
+  for (RobotSample& s : tracks[1].samples) s.mode = "reconstructor";
+  auto run = EvaluateRun(tracks);
+  ASSERT_TRUE(run.ok()) << run.status().message();
+  EXPECT_EQ(run->robots[0].mode_switches, 2u);
+  EXPECT_EQ(run->robots[1].mode_switches, 0u);
+  EXPECT_EQ(run->mode_switches, 2u);
+  EXPECT_NEAR(run->robots[0].mode_time_s.at("explorer"), 7.0, kExact);
+  EXPECT_NEAR(run->robots[0].mode_time_s.at("reconstructor"), 3.0, kExact);
+  EXPECT_NEAR(run->mode_time_s.at("reconstructor"), 3.0 + 10.0, kExact);
+  EXPECT_NEAR(run->mode_distance_m.at("reconstructor"), 3.0 + 4.0, kExact);
+  EXPECT_NEAR(run->mode_distance_m.at("explorer"), 7.0, kExact);
 }
 
 TEST(EvaluateRun, ARobotWhoseLogEndsEarlyWaitsForTheRest) {

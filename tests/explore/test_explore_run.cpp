@@ -106,6 +106,11 @@ TEST(ExploreRun, ShortRunWritesEveryArtefactAndItsMetricsAgree) {
   EXPECT_EQ(m["plan_calls"], loop.plan_calls.size());
   EXPECT_EQ(m["frames_fused"], loop.frames_fused);
   EXPECT_EQ(m["blocks_dropped_memory"], 0);
+  // Greedy drives in the explorer mode only: all of the time and distance is there.
+  EXPECT_EQ(m["mode_switches"], 0);
+  ASSERT_TRUE(m["mode_time_s"].contains("explorer")) << m["mode_time_s"];
+  EXPECT_NEAR(m["mode_distance_m"]["explorer"].get<double>(), report->metrics.distance_total_m,
+              5e-3);
   EXPECT_EQ(m["terminated"], loop.terminated);
   EXPECT_EQ(m["distance_per_robot_m"].size(), 2u);
   EXPECT_NEAR(m["completeness"].get<double>(), report->quality.completeness, 5e-5);
