@@ -248,9 +248,18 @@ TEST_P(ApartmentValidity, ClosedReachableClear) {
 
 INSTANTIATE_TEST_SUITE_P(Seeds, ApartmentValidity,
                          ::testing::Combine(::testing::Values(ApartmentSize::kS, ApartmentSize::kM,
-                                                              ApartmentSize::kL,
-                                                              ApartmentSize::kXL),
+                                                              ApartmentSize::kL),
                                             ::testing::Range(0, 8)));
+
+// XL on its own, so the sanitizer run can take two of its seeds (scripts/sanitize, for time).
+class ApartmentValidityXL : public ::testing::TestWithParam<int> {};
+
+TEST_P(ApartmentValidityXL, ClosedReachableClear) {
+  const World w = Generate(ApartmentSize::kXL, uint64_t(GetParam()));
+  CheckApartment(w, ApartmentSize::kXL, "XL seed " + std::to_string(GetParam()));
+}
+
+INSTANTIATE_TEST_SUITE_P(Seeds, ApartmentValidityXL, ::testing::Range(0, 8));
 
 TEST(Apartment, ParametricOnlyWithoutIndex) {
   const World w = Generate(ApartmentSize::kS, 11, /*meshes=*/false);
