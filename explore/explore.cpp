@@ -182,7 +182,6 @@ Status Explorer::Fuse(RobotRun& r, bool force) {
   Result<PlanningFrameStats> stats =
       IntegratePlanningFrame(out.depth, out.color, p_.fuse_labels ? &out.labels : nullptr, camera,
                              T_W_C, ip, *volume_, map_);
-  result_.timings.fuse_ms += NowMs() - t0;
   if (!stats.ok()) return stats.status();
   result_.blocks_dropped += stats->integrate.blocks_refused;
   if (recon_) {  // the same frame into the finer volume, for the mesh alone
@@ -190,6 +189,7 @@ Status Explorer::Fuse(RobotRun& r, bool force) {
     if (!fine.ok()) return fine.status();
     result_.blocks_dropped += fine->blocks_refused;
   }
+  result_.timings.fuse_ms += NowMs() - t0;
   touched_.insert(touched_.end(), stats->integrate.touched_blocks.begin(),
                   stats->integrate.touched_blocks.end());
   ++r.frames;

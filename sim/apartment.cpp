@@ -2,6 +2,7 @@
 // (layout, walls, floors and ceilings, furniture, mirror), all drawing from one seeded stream.
 #include "sim/apartment.h"
 
+#include <iterator>
 #include <string>
 #include <utility>
 #include <vector>
@@ -11,21 +12,27 @@
 
 namespace voxplan {
 
+namespace {
+
+// One row per ApartmentSize, in its order: the name and the gross floor area range.
+struct SizeClass {
+  const char* name;
+  const char* lower_name;  // also accepted
+  float min_m2, max_m2;
+};
+constexpr SizeClass kSizeClasses[] = {{"S", "s", 60.0f, 110.0f},
+                                      {"M", "m", 110.0f, 200.0f},
+                                      {"L", "l", 200.0f, 350.0f},
+                                      {"XL", "xl", 300.0f, 450.0f}};
+static_assert(std::size(kSizeClasses) == size_t(ApartmentSize::kXL) + 1);
+
+const SizeClass& ClassOf(ApartmentSize size) { return kSizeClasses[int(size)]; }
+
+}  // namespace
+
 void ApartmentAreaRange(ApartmentSize size, float* min_m2, float* max_m2) {
-  switch (size) {
-    case ApartmentSize::kS:
-      *min_m2 = 60.0f, *max_m2 = 110.0f;
-      break;
-    case ApartmentSize::kM:
-      *min_m2 = 110.0f, *max_m2 = 200.0f;
-      break;
-    case ApartmentSize::kL:
-      *min_m2 = 200.0f, *max_m2 = 350.0f;
-      break;
-    default:
-      *min_m2 = 300.0f, *max_m2 = 450.0f;
-      break;
-  }
+  *min_m2 = ClassOf(size).min_m2;
+  *max_m2 = ClassOf(size).max_m2;
 }
 
 Result<World> GenerateApartment(const ApartmentParams& params) {
@@ -62,24 +69,14 @@ Result<World> GenerateApartment(const ApartmentParams& params) {
 }
 
 Result<ApartmentSize> ParseApartmentSize(const std::string& text) {
-  if (text == "S" || text == "s") return ApartmentSize::kS;
-  if (text == "M" || text == "m") return ApartmentSize::kM;
-  if (text == "L" || text == "l") return ApartmentSize::kL;
-  if (text == "XL" || text == "xl") return ApartmentSize::kXL;
+  for (int i = 0; i < int(std::size(kSizeClasses)); ++i) {
+    if (text == kSizeClasses[i].name || text == kSizeClasses[i].lower_name) {
+      return ApartmentSize(i);
+    }
+  }
   return InvalidArgument("apartment size must be S, M, L or XL, got '" + text + "'");
 }
 
-const char* ApartmentSizeName(ApartmentSize size) {
-  switch (size) {
-    case ApartmentSize::kS:
-      return "S";
-    case ApartmentSize::kM:
-      return "M";
-    case ApartmentSize::kL:
-      return "L";
-    default:
-      return "XL";
-  }
-}
+const char* ApartmentSizeName(ApartmentSize size) { return ClassOf(size).name; }
 
 }  // namespace voxplan

@@ -1,8 +1,10 @@
 // The extension tables behind vp_host_api.get_extension (planner ABI 1.1): a name, a version
 // and a static table each. A table grows by appended fields only, its version with it.
 #include <algorithm>
+#include <cstdint>
 #include <cstring>
 #include <string_view>
+#include <vector>
 
 #include "plugins/host/host_internal.h"
 
@@ -33,17 +35,13 @@ vp_status GetInstanceSurface(const vp_world* w, uint32_t id, const vp_surface_vo
     }
     w->have_surface_by_instance = true;
   }
-  if (id > uint32_t(INT32_MAX)) {  // no instance can have it: voxels store ids as int32_t
-    *out = w->surface_by_instance.data();
-    *count = 0;
-    return VP_OK;
-  }
-  const int32_t key = int32_t(id);
+  // Compared as int64_t: voxels store ids as int32_t, so an id past INT32_MAX matches none.
+  const int64_t key = id;
   const std::vector<vp_surface_voxel>& v = w->surface_by_instance;
   const auto begin = std::lower_bound(
-      v.begin(), v.end(), key, [](const vp_surface_voxel& a, int32_t k) { return a.instance < k; });
+      v.begin(), v.end(), key, [](const vp_surface_voxel& a, int64_t k) { return a.instance < k; });
   const auto end = std::upper_bound(
-      begin, v.end(), key, [](int32_t k, const vp_surface_voxel& b) { return k < b.instance; });
+      begin, v.end(), key, [](int64_t k, const vp_surface_voxel& b) { return k < b.instance; });
   *out = w->surface_by_instance.data() + (begin - w->surface_by_instance.begin());
   *count = uint64_t(end - begin);
   return VP_OK;

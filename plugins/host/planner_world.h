@@ -89,11 +89,11 @@ struct PlannerTask {
   uint32_t tag = 0;  // the plugin's own id
 };
 
-// One scanning mode (Guo 2022): speed and the camera's view.
 // Where a mode's camera sits (VP_MOUNT_*): the base centre, a head at a fixed height with a tilt,
 // or an arm that sets the camera's height and offset.
 enum class CameraMount : int32_t { kBase = 0, kHead = 1, kArm = 2 };
 
+// One scanning mode (Guo 2022): speed and the camera's view.
 struct ScanMode {
   float max_speed_mps = 0.5f;
   float max_turn_rate_radps = 1.f;
