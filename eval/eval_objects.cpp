@@ -31,6 +31,9 @@ Result<ObjectsEvalResult> EvaluateObjects(const Mesh& reconstruction, const Worl
                                           const ObjectEvalParams& params) {
   if (!(params.samples_per_m2 > 0.f) || !std::isfinite(params.samples_per_m2))
     return InvalidArgument("EvaluateObjects: samples_per_m2 must be positive");
+  for (float t : params.extra_thresholds_m)
+    if (!(t >= 0.f) || !std::isfinite(t))
+      return InvalidArgument("EvaluateObjects: thresholds must be non-negative");
   if (!(params.threshold_m >= 0.f) || !std::isfinite(params.threshold_m))
     return InvalidArgument("EvaluateObjects: threshold_m must be non-negative");
   if (!(params.max_attribution_distance_m >= 0.f))
@@ -111,11 +114,16 @@ Result<ObjectsEvalResult> EvaluateObjects(const Mesh& reconstruction, const Worl
   const double threshold = double(params.threshold_m);
   size_t covered_all = 0;
   for (size_t k = 0; k < result.objects.size(); ++k) {
-    size_t covered = 0;
-    for (size_t s = first_sample[k]; s < first_sample[k + 1]; ++s)
-      covered += coverage[s] <= threshold;
-    result.objects[k].completeness =
-        double(covered) / double(first_sample[k + 1] - first_sample[k]);
+    const double n = double(first_sample[k + 1] - first_sample[k]);
+    auto share_within = [&](double t) {
+      size_t covered = 0;
+      for (size_t s = first_sample[k]; s < first_sample[k + 1]; ++s) covered += coverage[s] <= t;
+      return covered;
+    };
+    const size_t covered = share_within(threshold);
+    result.objects[k].completeness = double(covered) / n;
+    for (float t : params.extra_thresholds_m)
+      result.objects[k].completeness_extra.push_back(double(share_within(double(t))) / n);
     covered_all += covered;
   }
   result.completeness_all_objects = double(covered_all) / double(truth_points.size());
@@ -160,6 +168,11 @@ Result<ObjectsEvalResult> EvaluateObjects(const Mesh& reconstruction, const Worl
     ++result.objects_reconstructed;
   }
   result.o_comp = comp_sum / double(result.objects.size());
+  for (size_t e = 0; e < params.extra_thresholds_m.size(); ++e) {
+    double sum_e = 0.0;
+    for (const ObjectEvalResult& object : result.objects) sum_e += object.completeness_extra[e];
+    result.o_comp_extra.push_back(sum_e / double(result.objects.size()));
+  }
   if (result.objects_reconstructed > 0) {
     result.o_rms_m = mean_sum / double(result.objects_reconstructed);
     result.mean_object_rms_m = rms_sum / double(result.objects_reconstructed);

@@ -23,6 +23,9 @@ namespace voxplan {
 struct ObjectEvalParams {
   // Guo gives no value for the distance threshold; this is EvaluateMesh's default.
   float threshold_m = 0.05f;
+  // More thresholds to report completeness at (ObjectEvalResult::completeness_extra), from the
+  // same samples: one evaluation gives Guo's O-Comp at, e.g., 2 cm and 5 cm.
+  std::vector<float> extra_thresholds_m;
   float samples_per_m2 = 10000.0f;
   // Small objects still get enough ground-truth samples for a share to mean something.
   size_t min_samples_per_object = 200;
@@ -39,15 +42,17 @@ struct ObjectEvalResult {
   std::string model;
   double ground_truth_area_m2 = 0.0;
   size_t ground_truth_samples = 0;
-  double completeness = 0.0;          // 0..1 (eq. 6)
-  size_t reconstruction_samples = 0;  // reconstruction samples attributed to this object
-  double accuracy_mean_m = 0.0;       // eq. 7; 0 when reconstruction_samples == 0
-  double accuracy_rms_m = 0.0;        // root mean square of the same distances
+  double completeness = 0.0;               // 0..1 (eq. 6)
+  std::vector<double> completeness_extra;  // at each of ObjectEvalParams::extra_thresholds_m
+  size_t reconstruction_samples = 0;       // reconstruction samples attributed to this object
+  double accuracy_mean_m = 0.0;            // eq. 7; 0 when reconstruction_samples == 0
+  double accuracy_rms_m = 0.0;             // root mean square of the same distances
 };
 
 struct ObjectsEvalResult {
   std::vector<ObjectEvalResult> objects;  // evaluated instances, in world.instances order
   double o_comp = 0.0;                    // mean completeness over `objects`
+  std::vector<double> o_comp_extra;       // the same at each extra threshold
   double o_rms_m = 0.0;  // mean accuracy_mean_m over objects with reconstruction samples (Guo)
   double mean_object_rms_m = 0.0;         // mean accuracy_rms_m over the same objects
   double completeness_all_objects = 0.0;  // share of all object samples covered (area-weighted)

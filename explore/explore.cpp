@@ -46,6 +46,8 @@ std::string Fmt(double v, int decimals = 2) {
 struct QueuedTask {
   PlannerTask task;
   std::vector<Eigen::Vector2f> path;  // the plugin's dense path to it; empty: route on the map
+  bool dwelt = false;                 // at the view: the dwell's frames are taken
+  int sweep_steps_done = 0;           // then the pitch sweep's (TaskCamera)
 };
 
 struct RobotRun {
@@ -66,6 +68,10 @@ struct RobotRun {
   uint64_t frames = 0;
   RobotTrack track;
   std::vector<PlannerTask> views;
+};
+
+struct CameraAim {
+  float yaw_rad, pitch_rad;  // camera yaw relative to the base; pitch
 };
 
 struct Failure {
@@ -113,9 +119,6 @@ class Explorer {
   void EndOnFault(const PlannerFault& fault, const std::string& head, PlanCallRecord record);
   void Record(bool with_completeness);
   double DistanceTotal() const;
-  struct CameraAim {
-    float yaw_rad, pitch_rad;  // camera yaw relative to the base; pitch
-  };
   CameraAim CameraTarget(const RobotRun& r) const;
 
   const World& world_;
@@ -131,7 +134,8 @@ class Explorer {
   std::unique_ptr<FloorMap> floor_;
   ExploreWorld explore_world_;
   std::vector<RobotRun> robots_;
-  std::vector<BlockIndex> touched_;  // since the last floor-map update
+  std::vector<uint8_t> structure_by_id_;  // world instance id -> scene structure (detector)
+  std::vector<BlockIndex> touched_;       // since the last floor-map update
   std::vector<Failure> failures_;
   std::vector<size_t> went_idle_;
   ExploreResult result_;
@@ -162,6 +166,13 @@ Status Explorer::Fuse(RobotRun& r, bool force) {
   double t0 = NowMs();
   RenderOutput out = raycaster_->Render(camera, T_W_C, rp);
   result_.timings.render_ms += NowMs() - t0;
+  if (p_.fuse_labels) {
+    t0 = NowMs();
+    const DetectorStats detected = ApplyDetector(out.labels, structure_by_id_, p_.detector, p_.seed,
+                                                 (uint64_t(r.index) << 32) | r.frames);
+    result_.objects_detected += detected.objects_out;
+    result_.timings.detect_ms += NowMs() - t0;
+  }
   if (p_.noise) {
     t0 = NowMs();
     KinectNoiseParams noise;
@@ -174,7 +185,7 @@ Status Explorer::Fuse(RobotRun& r, bool force) {
     result_.timings.noise_ms += NowMs() - t0;
   }
   IntegrateParams ip;
-  ip.min_depth_m = 0.1f;
+  ip.min_depth_m = r.robot.mode_params().min_range_m;
   ip.max_depth_m = r.robot.mode_params().max_range_m;
   ip.clear_beyond_max_depth = p_.clear_beyond_range;
   ip.integrate_color = p_.fuse_color;
@@ -194,6 +205,7 @@ Status Explorer::Fuse(RobotRun& r, bool force) {
                   stats->integrate.touched_blocks.end());
   ++r.frames;
   ++result_.frames_fused;
+  result_.frames[r.index].push_back({r.t_s, T_W_C});
   return Status::Ok();
 }
 
@@ -336,47 +348,95 @@ std::pair<float, float> TrajectoryYawPitch(const std::vector<CameraSample>& tr, 
   return {tr.back().yaw_rad, tr.back().pitch_rad};
 }
 
-Explorer::CameraAim Explorer::CameraTarget(const RobotRun& r) const {
+// The camera yaw (relative to the base) and pitch that aim from the robot's camera at a point.
+CameraAim AimAt(const Robot& robot, const Eigen::Vector3f& target_W) {
+  const Eigen::Vector3f d = target_W - robot.T_W_C().translation();
+  const float limit = robot.max_abs_pitch_rad();
+  const float pitch = d.head<2>().norm() > 1e-6f || std::abs(d.z()) > 1e-6f
+                          ? std::atan2(d.z(), d.head<2>().norm())
+                          : 0.f;
+  const float yaw_W = d.head<2>().norm() > 1e-6f
+                          ? std::atan2(d.y(), d.x())
+                          : robot.state().heading_rad + robot.state().camera_yaw_rad;
+  return {WrapAngle(yaw_W - robot.state().heading_rad), std::clamp(pitch, -limit, limit)};
+}
+
+CameraAim Explorer::CameraTarget(const RobotRun& r) const {
+  // A task that looks at a point aims there on the way (vp.task's look_at).
+  if (r.camera_trajectory.empty() && !r.queue.empty() && r.queue.front().task.camera.look_at)
+    return AimAt(r.robot, r.queue.front().task.camera.look_at_W);
   // Along the motion and level unless the plugin said otherwise (a view may have tilted it).
   if (r.camera_trajectory.empty()) return {0.f, 0.f};
   const auto [world_yaw, pitch] =
       TrajectoryYawPitch(r.camera_trajectory, float(r.t_s - r.trajectory_t0_s));
-  const float max_pitch = Deg2Rad(r.robot.params().max_abs_pitch_deg);
+  const float max_pitch = r.robot.max_abs_pitch_rad();
   return {WrapAngle(world_yaw - r.robot.state().heading_rad),
           std::clamp(pitch, -max_pitch, max_pitch)};
 }
 
-// One primitive at the view: turn the base, then the camera, then pitch, then dwell and capture.
+// One primitive at the view: turn the base, move the arm camera (vp.task), turn the camera
+// (at the look-at point, or to the task's angles), then dwell and capture, then the pitch sweep.
 Status Explorer::StepToView(RobotRun& r, QueuedTask& q) {
   const double c = r.robot.clock_s();
   const RobotState& s = r.robot.state();
+  const TaskCamera& cam = q.task.camera;
   const float turn_step = Deg2Rad(p_.turn_step_deg);
   const float dh = WrapAngle(q.task.theta_rad - s.heading_rad);
   if (std::abs(dh) > 1e-3f) {
     r.robot.TurnTo(s.heading_rad + Clamp(dh, turn_step));
     return AfterPrimitive(r, c);
   }
-  const float dy = WrapAngle(q.task.camera_yaw_rad - s.camera_yaw_rad);
-  if (std::abs(dy) > 1e-3f) {
-    r.robot.SetCameraYaw(s.camera_yaw_rad + Clamp(dy, turn_step));
-    return AfterPrimitive(r, c);
+  if (cam.ArmSet() && !q.dwelt) {
+    const ModeParams& m = r.robot.mode_params();
+    const float head_h = r.robot.params().camera_height_m;
+    const float h =
+        cam.HeightSet() ? cam.height_m : std::clamp(head_h, m.arm.height_min_m, m.arm.height_max_m);
+    const Eigen::Vector2f o =
+        cam.OffsetSet() ? cam.offset_m : Eigen::Vector2f(m.arm.reach_min_m, 0.f);
+    if ((ArmOffset(h, o, head_h) - s.camera_offset_B).norm() > 1e-4f) {
+      VOXPLAN_RETURN_IF_ERROR(r.robot.SetArmCamera(h, o));
+      return AfterPrimitive(r, c);
+    }
   }
-  const float max_pitch = Deg2Rad(r.robot.params().max_abs_pitch_deg);
-  const float pitch = std::clamp(q.task.camera_pitch_rad, -max_pitch, max_pitch);
-  if (std::abs(pitch - s.camera_pitch_rad) > 1e-3f) {
-    VOXPLAN_RETURN_IF_ERROR(r.robot.SetCameraPitch(pitch));
-    return AfterPrimitive(r, c);
+  if (!q.dwelt) {
+    const CameraAim aim = cam.look_at ? AimAt(r.robot, cam.look_at_W)
+                                      : CameraAim{q.task.camera_yaw_rad, q.task.camera_pitch_rad};
+    const float dy = WrapAngle(aim.yaw_rad - s.camera_yaw_rad);
+    if (std::abs(dy) > 1e-3f) {
+      r.robot.SetCameraYaw(s.camera_yaw_rad + Clamp(dy, turn_step));
+      return AfterPrimitive(r, c);
+    }
+    const float max_pitch = r.robot.max_abs_pitch_rad();
+    const float pitch = std::clamp(aim.pitch_rad, -max_pitch, max_pitch);
+    if (std::abs(pitch - s.camera_pitch_rad) > 1e-3f) {
+      VOXPLAN_RETURN_IF_ERROR(r.robot.SetCameraPitch(pitch));
+      return AfterPrimitive(r, c);
+    }
+    r.robot.WrapCameraYaw();
+    // Dwell at the view: the task's time, at least the robot's capture time. With time-based
+    // capture the dwell yields floor(dwell x rate) frames (at least one), spread over it.
+    const double dwell_s = std::max(double(q.task.dwell_s), double(r.robot.params().dwell_s));
+    const float capture_hz = r.robot.mode_params().capture_hz;
+    const int frames = capture_hz > 0.f ? std::max(1, int(std::floor(dwell_s * capture_hz))) : 1;
+    for (int k = 0; k < frames; ++k) {
+      r.t_s += dwell_s / frames;
+      Sample(r, RobotStatus::kBusy);
+      VOXPLAN_RETURN_IF_ERROR(Fuse(r, true));
+    }
+    q.dwelt = true;
   }
-  r.robot.WrapCameraYaw();
-  // Dwell at the view: the task's time, at least the robot's capture time. With time-based
-  // capture the dwell yields floor(dwell x rate) frames (at least one), spread over it.
-  const double dwell_s = std::max(double(q.task.dwell_s), double(r.robot.params().dwell_s));
-  const float capture_hz = r.robot.mode_params().capture_hz;
-  const int frames = capture_hz > 0.f ? std::max(1, int(std::floor(dwell_s * capture_hz))) : 1;
-  for (int k = 0; k < frames; ++k) {
-    r.t_s += dwell_s / frames;
-    Sample(r, RobotStatus::kBusy);
-    VOXPLAN_RETURN_IF_ERROR(Fuse(r, true));
+  if (cam.Sweeps()) {  // the head's tilt up and down at the view (Guo 2022), a frame per step
+    const int steps = int(std::floor(
+        (cam.sweep_pitch_max_rad - cam.sweep_pitch_min_rad) / cam.sweep_pitch_step_rad + 1e-4f));
+    if (q.sweep_steps_done <= steps) {
+      const float limit = r.robot.max_abs_pitch_rad();
+      const float pitch =
+          std::clamp(cam.sweep_pitch_min_rad + float(q.sweep_steps_done) * cam.sweep_pitch_step_rad,
+                     -limit, limit);
+      ++q.sweep_steps_done;
+      VOXPLAN_RETURN_IF_ERROR(r.robot.SetCameraPitch(pitch));
+      return AfterPrimitive(r, c, /*force_fuse=*/true);
+    }
   }
   if (q.task.tag != kPathOnlyTag) r.views.push_back(q.task);
   r.queue.pop_front();
@@ -404,7 +464,12 @@ Status Explorer::Advance(RobotRun& r, double t_end_s) {
     }
     QueuedTask& q = r.queue.front();
     if (!r.routed) {
+      const double c = r.robot.clock_s();
       r.robot.SetMode(q.task.mode == 1 ? RobotMode::kReconstructor : RobotMode::kExplorer);
+      if (r.robot.clock_s() != c) {  // the switch took time (ModeParams::switch_s)
+        VOXPLAN_RETURN_IF_ERROR(AfterPrimitive(r, c));
+        continue;
+      }
       if (!RouteTo(r, q)) {
         Fail(r, "no route over the known floor map to (" + Fmt(q.task.position_m.x()) + ", " +
                     Fmt(q.task.position_m.y()) + ")");
@@ -511,7 +576,7 @@ std::vector<PlannerRobot> Explorer::Snapshot() const {
       sm.max_turn_rate_radps = mp.max_turn_rate_radps;
       sm.horizontal_fov_rad = Deg2Rad(mp.horizontal_fov_deg);
       sm.vertical_fov_rad = 2.f * std::atan(0.5f * float(cam.height) / cam.fy);
-      sm.min_range_m = 0.1f;
+      sm.min_range_m = mp.min_range_m;
       sm.max_range_m = mp.max_range_m;
       sm.image_width = cam.width;
       sm.image_height = cam.height;
@@ -519,13 +584,25 @@ std::vector<PlannerRobot> Explorer::Snapshot() const {
       sm.fy = cam.fy;
       sm.cx = cam.cx;
       sm.cy = cam.cy;
-      // Today's robot: one head camera for both modes, switched free.
-      sm.mount = CameraMount::kHead;
       sm.capture_hz = mp.capture_hz;
-      sm.camera_height_min_m = sm.camera_height_max_m = rp.camera_height_m;
-      sm.min_pitch_rad = pr.min_pitch_rad;
-      sm.max_pitch_rad = pr.max_pitch_rad;
+      sm.switch_s = mp.switch_s;
       sm.camera_turn_rate_radps = std::min(rp.camera_yaw_rate_radps, rp.camera_pitch_rate_radps);
+      if (mp.mount == MountKind::kArm) {
+        sm.mount = CameraMount::kArm;
+        sm.camera_height_min_m = mp.arm.height_min_m;
+        sm.camera_height_max_m = mp.arm.height_max_m;
+        sm.reach_min_m = mp.arm.reach_min_m;
+        sm.reach_max_m = mp.arm.reach_max_m;
+        sm.reach_half_angle_rad = Deg2Rad(mp.arm.reach_half_angle_deg);
+        sm.max_pitch_rad = Deg2Rad(mp.arm.max_abs_pitch_deg);
+        sm.min_pitch_rad = -sm.max_pitch_rad;
+        sm.camera_speed_mps = mp.arm.speed_mps;
+      } else {
+        sm.mount = CameraMount::kHead;
+        sm.camera_height_min_m = sm.camera_height_max_m = rp.camera_height_m;
+        sm.min_pitch_rad = pr.min_pitch_rad;
+        sm.max_pitch_rad = pr.max_pitch_rad;
+      }
       pr.modes.push_back(sm);
     }
     out.push_back(std::move(pr));
@@ -692,6 +769,13 @@ Result<ExploreResult> Explorer::Run(const std::vector<Eigen::Vector2f>& starts) 
   Result<std::unique_ptr<MeshRaycaster>> raycaster = MeshRaycaster::Create(world_);
   if (!raycaster.ok()) return raycaster.status();
   raycaster_ = std::move(raycaster).value();
+  // The oracle classifier: every world instance carries its class name (shown once it is in the
+  // map); structure ids are kept from the detector's noise.
+  for (const Instance& instance : world_.instances) {
+    map_.SetInstanceClass(instance.id, instance.class_name);
+    if (structure_by_id_.size() <= instance.id) structure_by_id_.resize(instance.id + 1, 0);
+    structure_by_id_[instance.id] = IsStructureClass(instance.class_name);
+  }
   RobotParams rp = p_.robot;
   rp.image_width = p_.image_width;
   rp.image_height = p_.image_height;
@@ -703,6 +787,7 @@ Result<ExploreResult> Explorer::Run(const std::vector<Eigen::Vector2f>& starts) 
     RobotRun r(i, std::move(robot).value(), p_.trigger);
     r.track.robot = "r" + std::to_string(i);
     robots_.push_back(std::move(r));
+    result_.frames.emplace_back();
   }
   for (RobotRun& r : robots_) {
     Sample(r, RobotStatus::kBusy);
@@ -790,6 +875,7 @@ Result<ExploreResult> Explorer::Run(const std::vector<Eigen::Vector2f>& starts) 
 Status ExploreParams::Validate() const {
   const VolumeParams volume{voxel_size_m, trunc_vox * voxel_size_m, max_memory_bytes};
   VOXPLAN_RETURN_IF_ERROR(volume.Validate().WithContext("explore"));
+  VOXPLAN_RETURN_IF_ERROR(detector.Validate());
   if (recon_voxel_size_m != 0.f) {
     const VolumeParams recon{recon_voxel_size_m, trunc_vox * recon_voxel_size_m, max_memory_bytes};
     VOXPLAN_RETURN_IF_ERROR(recon.Validate().WithContext("explore: reconstruction volume"));

@@ -33,12 +33,14 @@
 #include <vector>
 
 #include "core/mesh.h"
+#include "core/pose.h"
 #include "core/status.h"
 #include "core/volume.h"
 #include "eval/eval_run.h"
 #include "planning/floor_map.h"
 #include "planning/planning_map.h"
 #include "plugins/host/plugin_host.h"
+#include "sim/detector.h"
 #include "sim/floor_plan.h"
 #include "sim/robot.h"
 #include "sim/world.h"
@@ -56,6 +58,8 @@ struct ExploreParams {
   float recon_voxel_size_m = 0.f;
   bool noise = true;        // Kinect noise on the rendered depth
   bool fuse_labels = true;  // instance labels into the object map
+  // How the labels are detected before they are fused (sim/detector.h): noisy by default.
+  DetectorParams detector;
   // Vertex colours of the final mesh only (no metric reads them): off saves rendering and
   // fusing colour, about a tenth of a frame's cost.
   bool fuse_color = true;
@@ -131,8 +135,14 @@ struct PlanCallRecord {
 };
 
 struct ExploreTimings {  // wall milliseconds, summed over the run
-  double render_ms = 0.0, noise_ms = 0.0, fuse_ms = 0.0, floor_ms = 0.0, plan_ms = 0.0,
-         series_ms = 0.0, total_ms = 0.0;
+  double render_ms = 0.0, detect_ms = 0.0, noise_ms = 0.0, fuse_ms = 0.0, floor_ms = 0.0,
+         plan_ms = 0.0, series_ms = 0.0, total_ms = 0.0;
+};
+
+// A frame the loop fused: when and from where.
+struct ExploreFrame {
+  double t_s = 0.0;
+  Pose3f T_W_C = Pose3f::Identity();
 };
 
 struct ExploreResult {
@@ -140,12 +150,14 @@ struct ExploreResult {
   std::string done_reason;  // "planner", "no_tasks" or "" (time limit)
   double time_s = 0.0;
   size_t frames_fused = 0;
+  size_t objects_detected = 0;  // summed over frames, after the detector's noise
   size_t failed_tasks = 0;
   size_t rejected_tasks = 0;
   size_t over_budget_calls = 0;
   size_t blocks_dropped = 0;       // map blocks not allocated: the map was at max_memory_bytes
   size_t failed_plans = 0;         // plan calls the plugin failed (messages in plan_log)
   std::vector<RobotTrack> tracks;  // one per robot: r0, r1, ...
+  std::vector<std::vector<ExploreFrame>> frames;     // per robot, every frame it fused
   std::vector<std::vector<PlannerTask>> task_views;  // per robot, views it reached, in order
   std::vector<PlanCallRecord> plan_calls;
   std::vector<std::string> plan_log;          // rejections, failures and the plugin's messages

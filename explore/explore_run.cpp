@@ -2,6 +2,7 @@
 // evaluation and the artefacts (explore/explore_run.h). Moved out of `voxplan explore` as it was.
 #include "explore/explore_run.h"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
@@ -89,6 +90,16 @@ Result<std::vector<Eigen::Vector3f>> ProbePoints(const Mesh& ground_truth,
   return probe_points;
 }
 
+// Whether EvaluateObjects has anything to judge: an instance beside the structure classes.
+bool HasObjects(const World& world) {
+  if (world.triangle_instance.size() != world.mesh.num_triangles()) return false;
+  const std::vector<std::string> structure = ObjectEvalParams{}.excluded_classes;
+  for (const Instance& instance : world.instances)
+    if (std::find(structure.begin(), structure.end(), instance.class_name) == structure.end())
+      return true;
+  return false;
+}
+
 // The final mesh (written at once), its quality against the ground truth and the run metrics.
 Status Evaluate(const ExploreRunParams& params, const World& world, const FloorPlan& plan,
                 const PointSetFilter& filter, ExploreRunReport& report) {
@@ -106,6 +117,16 @@ Status Evaluate(const ExploreRunParams& params, const World& world, const FloorP
     Result<MeshEvalResult> q = EvaluateMesh(report.mesh, world.mesh, ep);
     if (!q.ok()) return q.status().Naming(params.scene);
     report.quality = *q;
+    if (HasObjects(world)) {
+      ObjectEvalParams op;
+      op.threshold_m = kObjectThreshold_m;
+      op.extra_thresholds_m = {kObjectExtraThreshold_m};
+      op.samples_per_m2 = float(params.eval_samples_per_m2);
+      op.seed = params.explore.seed;
+      Result<ObjectsEvalResult> objects = EvaluateObjects(report.mesh, world, op);
+      if (!objects.ok()) return objects.status().Naming(params.scene);
+      report.objects = std::move(*objects);
+    }
   }
   Result<RunMetrics> metrics = EvaluateRun(report.loop.tracks, {.scene_area_m2 = FloorArea(plan)});
   if (!metrics.ok()) return metrics.status();

@@ -10,12 +10,14 @@
 // camera's range and field of view; the whole ground-truth surface when no tour can be planned.
 #include <Eigen/Core>
 #include <functional>
+#include <optional>
 #include <string>
 #include <vector>
 
 #include "core/mesh.h"
 #include "core/status.h"
 #include "eval/eval_mesh.h"
+#include "eval/eval_objects.h"
 #include "eval/eval_run.h"
 #include "explore/explore.h"
 #include "plugins/host/plugin_host.h"
@@ -43,12 +45,20 @@ struct ExploreRunObserver {
   ExploreProgressFn progress;                                  // RunExplore's progress
 };
 
+// Guo 2022 gives no O-Comp threshold: 2 cm (with a 2 cm reconstruction volume) is the primary,
+// 5 cm (the planning voxel) the second (metrics.json's o_comp_2cm, o_comp_5cm).
+inline constexpr float kObjectThreshold_m = 0.02f;
+inline constexpr float kObjectExtraThreshold_m = 0.05f;
+
 struct ExploreRunReport {
   std::string world_name;
   std::string planner_name;
   ExploreResult loop;      // the loop's result, final maps included
   Mesh mesh;               // the fused map's final mesh (mesh.ply)
   MeshEvalResult quality;  // all zero when the mesh is empty
+  // Per object (Guo 2022's O-Comp at 2 cm, extra threshold 5 cm, and O-RMS) on the same mesh;
+  // empty when the mesh is or the world has no object beside its structure.
+  std::optional<ObjectsEvalResult> objects;
   RunMetrics metrics;
   double scene_area_m2 = 0.0;
   bool observable_reference = false;  // completeness over the tour-observable surface, else all

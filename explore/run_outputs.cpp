@@ -77,6 +77,13 @@ json MetricsObject(const ExploreRunParams& params, const ExploreRunReport& repor
   // Only with the option, so runs without it keep their bytes: what the mesh was fused at.
   if (params.explore.recon_voxel_size_m > 0.f)
     m["mesh_voxel_size_m"] = RoundTo(params.explore.recon_voxel_size_m, 4);
+  // Per object (Guo 2022 eq. 6 and 7), null without objects; rows in objects.csv.
+  const std::optional<ObjectsEvalResult>& objects = report.objects;
+  m["o_comp_2cm"] = objects ? json(RoundTo(objects->o_comp, 4)) : json();
+  m["o_comp_5cm"] = objects ? json(RoundTo(objects->o_comp_extra.at(0), 4)) : json();
+  m["o_rms_m"] = objects ? json(RoundTo(objects->o_rms_m, 5)) : json();
+  m["objects_evaluated"] = objects ? objects->objects.size() : 0;
+  m["objects_reconstructed"] = objects ? objects->objects_reconstructed : 0;
   json per_robot = json::array();
   for (const RobotRunMetrics& rm : metrics.robots) per_robot.push_back(RoundTo(rm.distance_m, 3));
   m["distance_per_robot_m"] = per_robot;
@@ -103,11 +110,39 @@ json MetricsObject(const ExploreRunParams& params, const ExploreRunReport& repor
   m["failed_tasks"] = r.failed_tasks;
   m["failed_plan_calls"] = r.failed_plans;
   m["frames_fused"] = r.frames_fused;
+  m["objects_detected"] = r.objects_detected;
   m["blocks_dropped_memory"] = r.blocks_dropped;
   m["terminated"] = r.terminated;
   m["done_reason"] = r.done_reason;
   if (r.planner_fault) m["planner_fault"] = FaultObject(*r.planner_fault);
   return m;
+}
+
+// A CSV field: quoted (quotes doubled) when it holds a comma, quote or line break, as a scene
+// file's model names may.
+std::string CsvField(const std::string& text) {
+  if (text.find_first_of(",\"\n\r") == std::string::npos) return text;
+  std::string quoted = "\"";
+  for (char c : text) quoted += c == '"' ? std::string("\"\"") : std::string(1, c);
+  return quoted + "\"";
+}
+
+// objects.csv: one row per evaluated object, in the world's instance order.
+std::vector<std::string> ObjectRows(const std::optional<ObjectsEvalResult>& objects) {
+  std::vector<std::string> rows = {
+      "id,class,model,area_m2,gt_samples,completeness_2cm,completeness_5cm,recon_samples,"
+      "accuracy_mean_m,accuracy_rms_m"};
+  if (!objects) return rows;
+  for (const ObjectEvalResult& o : objects->objects) {
+    std::ostringstream line;
+    line << o.id << "," << CsvField(o.class_name) << "," << CsvField(o.model) << ","
+         << RoundTo(o.ground_truth_area_m2, 4) << "," << o.ground_truth_samples << ","
+         << RoundTo(o.completeness, 4) << "," << RoundTo(o.completeness_extra.at(0), 4) << ","
+         << o.reconstruction_samples << "," << RoundTo(o.accuracy_mean_m, 5) << ","
+         << RoundTo(o.accuracy_rms_m, 5);
+    rows.push_back(line.str());
+  }
+  return rows;
 }
 
 // plan_calls.csv: one row per call; elapsed_ms and over_budget are wall time.
@@ -181,6 +216,7 @@ std::string RunSummaryJson(const ExploreRunParams& params, const ExploreRunRepor
   j["setup_ms"] = RoundTo(report.setup_ms, 1);
   j["tour_frames"] = report.tour_frames;
   j["render_ms"] = RoundTo(t.render_ms, 1);
+  j["detect_ms"] = RoundTo(t.detect_ms, 1);
   j["noise_ms"] = RoundTo(t.noise_ms, 1);
   j["fuse_ms"] = RoundTo(t.fuse_ms, 1);
   j["floor_ms"] = RoundTo(t.floor_ms, 1);
@@ -209,13 +245,15 @@ Status WriteRunOutputs(const ExploreRunParams& params, const ExploreRunReport& r
   if (Status s = WriteLines(r.plan_log, path); !s.ok()) return s.Naming(path);
   path = InFolder(params.out_dir, "plan_calls.csv");
   if (Status s = WriteLines(PlanCallRows(r.plan_calls), path); !s.ok()) return s.Naming(path);
+  path = InFolder(params.out_dir, "objects.csv");
+  if (Status s = WriteLines(ObjectRows(report.objects), path); !s.ok()) return s.Naming(path);
   return WriteTopDown(r, InFolder(params.out_dir, "topdown.png"));
 }
 
 std::vector<std::string> RunOutputFiles(const std::string& out_dir) {
   std::vector<std::string> paths;
   for (const char* name : {"mesh.ply", "metrics.json", "run_log.csv", "timeseries.csv",
-                           "plan_log.txt", "plan_calls.csv", "topdown.png"})
+                           "plan_log.txt", "plan_calls.csv", "objects.csv", "topdown.png"})
     paths.push_back(InFolder(out_dir, name));
   return paths;
 }

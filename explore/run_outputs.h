@@ -10,6 +10,7 @@
 //   topdown.png     the final floor map, each robot's path, start / end marks, reached views
 //   plan_log.txt    rejected tasks, failed tasks and plans, the plugin's messages
 //   plan_calls.csv  one row per plan call with its wall time and the plugin's diagnostics
+//   objects.csv     per object: completeness at 2 and 5 cm, accuracy (Guo 2022 eq. 6, 7)
 // Every error names the file it could not write. The report as JSON is here too, beside
 // metrics.json.
 #include <string>

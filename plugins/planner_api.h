@@ -321,6 +321,36 @@ typedef struct vp_objects_ext {
                                     uint64_t* out_count);
 } vp_objects_ext;
 
+/* "vp.task" version 1: where the camera is at a task (Guo 2022's reconstruction views are 3-D
+ * camera poses, T = (x, y, z, theta, phi)). The host validates each against the task's mode:
+ * a camera height or offset only on an arm mount and inside its workspace (vp_mode_params'
+ * camera_height_*, reach_*), the camera not in occupied or unknown space, the sweep within the
+ * mode's pitch range. At the view the robot turns its base, moves the arm, aims (at look_at_W
+ * when look_at, else the task's camera yaw and pitch), dwells, then steps the pitch through the
+ * sweep with a frame at each step. */
+#define VP_EXT_TASK "vp.task"
+typedef struct vp_task_ext {
+  uint32_t struct_size;
+  float camera_height_m;    /* optical centre above the floor; NAN: the mount's rest height */
+  float camera_offset_m[2]; /* base frame (forward, left) from the base centre; NAN: rest */
+  int32_t look_at;          /* 1: aim at look_at_W while driving to and standing at the task */
+  float look_at_W[3];
+  float sweep_pitch_min_rad, sweep_pitch_max_rad; /* a tilt sweep after the dwell (the head's */
+  float sweep_pitch_step_rad;                     /* "up and down", G L97); step 0: none */
+  int32_t object_id; /* the vp_instance the view is for, -1 none (logged, not interpreted) */
+} vp_task_ext;
+
+typedef struct vp_task_ext_table {
+  vp_extension_header header;
+  /* add_task with the camera's part; ext may be NULL (the defaults, as add_task). */
+  vp_status (*add_task_ext)(vp_plan_output* o, uint32_t robot, const vp_task* task,
+                            const vp_task_ext* ext);
+  /* The camera parts of get_robot_queue's tasks, in the same order, each ext->struct_size bytes
+   * apart (tasks added without one carry the defaults). */
+  vp_status (*get_robot_queue_ext)(const vp_world* w, uint32_t robot, const vp_task_ext** out,
+                                   uint32_t* out_count);
+} vp_task_ext_table;
+
 /* Whether a host table has a field: a plugin that also runs on older hosts of its major version
  * tests this before calling an appended function. */
 #define VP_HOST_HAS(host, field)                                                          \

@@ -94,6 +94,16 @@ class FloorView {
 
 // Read-only view of the maps for one plan() call. Spans point at host memory that stays valid
 // until Plan returns; copy what must outlive it.
+// A vp_task_ext that changes nothing: the mount's rest pose, no look-at, no sweep, no object.
+inline vp_task_ext DefaultTaskExt() {
+  vp_task_ext e{};
+  e.struct_size = sizeof(e);
+  e.camera_height_m = std::numeric_limits<float>::quiet_NaN();
+  e.camera_offset_m[0] = e.camera_offset_m[1] = std::numeric_limits<float>::quiet_NaN();
+  e.object_id = -1;
+  return e;
+}
+
 class WorldView {
  public:
   WorldView(const vp_host_api* host, const vp_world* world) : host_(host), world_(world) {
@@ -209,6 +219,26 @@ class WorldView {
     return {voxels, size_t(count)};
   }
 
+  // vp.task 1: the camera parts of Queue(robot)'s tasks, in the same order.
+  std::vector<vp_task_ext> QueueExt(uint32_t robot) const {
+    const auto& ext = RequireExtension<vp_task_ext_table>(VP_EXT_TASK, 1);
+    const vp_task_ext* first = nullptr;
+    uint32_t count = 0;
+    Check(ext.get_robot_queue_ext(world_, robot, &first, &count), "get_robot_queue_ext");
+    std::vector<vp_task_ext> out;
+    if (count == 0) return out;
+    // The host's records may be longer than this header's: step by its size, keep ours.
+    const uint32_t stride = first->struct_size;
+    for (uint32_t i = 0; i < count; ++i) {
+      vp_task_ext e = DefaultTaskExt();
+      const char* p = reinterpret_cast<const char*>(first) + size_t(i) * stride;
+      std::memcpy(&e, p, std::min<size_t>(sizeof(e), stride));
+      e.struct_size = sizeof(e);
+      out.push_back(e);
+    }
+    return out;
+  }
+
   std::span<const vp_instance> Instances() const {
     const vp_instance* instances = nullptr;
     uint32_t count = 0;
@@ -258,6 +288,15 @@ class PlanOutput {
   }
   void AddTask(uint32_t robot, const vp_task& task) {
     Check(host_->add_task(out_, robot, &task), "add_task");
+  }
+  // vp.task 1: a task with its camera part (DefaultTaskExt() for the fields left alone).
+  void AddTask(uint32_t robot, const vp_task& task, const vp_task_ext& camera) {
+    const vp_extension_header* h = host_->get_extension(VP_EXT_TASK, 1);
+    if (h == nullptr || h->struct_size < sizeof(vp_task_ext_table))
+      throw Error(VP_ERROR_NOT_AVAILABLE,
+                  "this host has no extension vp.task version 1; run it with a newer voxplan");
+    Check(reinterpret_cast<const vp_task_ext_table*>(h)->add_task_ext(out_, robot, &task, &camera),
+          "add_task_ext");
   }
   void SetPath(uint32_t robot, std::span<const vp_path_point> points) {
     Check(host_->set_path(out_, robot, points.data(), uint32_t(points.size())), "set_path");

@@ -33,6 +33,30 @@ Status ValidateMode(const ModeParams& m, const char* name) {
                            " horizontal_fov_deg must be in (1, 179)");
   if (!(m.max_range_m > 0.f))
     return InvalidArgument(std::string("RobotParams: ") + name + " max_range_m must be > 0");
+  if (!(m.min_range_m > 0.f && m.min_range_m < m.max_range_m))
+    return InvalidArgument(std::string("RobotParams: ") + name +
+                           " min_range_m must be > 0 and below max_range_m");
+  if (!(m.switch_s >= 0.f && m.switch_s <= kMaxSwitchS))
+    return InvalidArgument(std::string("RobotParams: ") + name + " switch_s must be in [0, " +
+                           std::to_string(int(kMaxSwitchS)) + "] s");
+  if (m.mount == MountKind::kArm) {
+    const ArmParams& a = m.arm;
+    if (!(a.height_min_m > 0.f && a.height_min_m <= a.height_max_m && a.height_max_m <= 3.f))
+      return InvalidArgument(std::string("RobotParams: ") + name +
+                             " arm heights must satisfy 0 < min <= max <= 3 m");
+    if (!(a.reach_min_m >= 0.f && a.reach_min_m <= a.reach_max_m && a.reach_max_m <= 3.f))
+      return InvalidArgument(std::string("RobotParams: ") + name +
+                             " arm reach must satisfy 0 <= min <= max <= 3 m");
+    if (!(a.reach_half_angle_deg >= 0.f && a.reach_half_angle_deg <= 180.f))
+      return InvalidArgument(std::string("RobotParams: ") + name +
+                             " arm reach_half_angle_deg must be in [0, 180]");
+    if (!(a.max_abs_pitch_deg >= 0.f && a.max_abs_pitch_deg <= 90.f))
+      return InvalidArgument(std::string("RobotParams: ") + name +
+                             " arm max_abs_pitch_deg must be in [0, 90]");
+    if (!(a.speed_mps > 0.f && a.speed_mps <= 10.f))
+      return InvalidArgument(std::string("RobotParams: ") + name +
+                             " arm speed_mps must be in (0, 10]");
+  }
   if (!(m.capture_hz >= 0.f && m.capture_hz <= kMaxCaptureHz))
     return InvalidArgument(std::string("RobotParams: ") + name + " capture_hz must be in [0, " +
                            std::to_string(int(kMaxCaptureHz)) + "]");
@@ -41,6 +65,8 @@ Status ValidateMode(const ModeParams& m, const char* name) {
 
 }  // namespace
 
+const char* MountKindName(MountKind mount) { return mount == MountKind::kHead ? "head" : "arm"; }
+
 const char* RobotModeName(RobotMode mode) {
   return mode == RobotMode::kExplorer ? "explorer" : "reconstructor";
 }
@@ -48,8 +74,19 @@ const char* RobotModeName(RobotMode mode) {
 ModeParams DefaultModeParams(RobotMode mode) {
   // Explorer: fast with far, wide vision; reconstructor: slow, close, narrow (Guo 2022 §3).
   // Speeds around Dong 2019's 0.3 m/s Turtlebots.
-  if (mode == RobotMode::kExplorer) return {0.5f, 1.0f, 90.0f, 5.0f};
-  return {0.2f, 0.5f, 58.0f, 2.5f};
+  ModeParams m;
+  if (mode == RobotMode::kExplorer) {
+    m.max_speed_mps = 0.5f;
+    m.max_turn_rate_radps = 1.0f;
+    m.horizontal_fov_deg = 90.0f;
+    m.max_range_m = 5.0f;
+  } else {
+    m.max_speed_mps = 0.2f;
+    m.max_turn_rate_radps = 0.5f;
+    m.horizontal_fov_deg = 58.0f;
+    m.max_range_m = 2.5f;
+  }
+  return m;
 }
 
 Status RobotParams::Validate() const {
@@ -79,7 +116,42 @@ Pose3f CameraPoseFromState(const RobotState& state, float camera_height_m) {
   T_W_C.linear().col(2) = forward;
   T_W_C.translation() =
       Eigen::Vector3f(state.position_W.x(), state.position_W.y(), camera_height_m);
+  const Eigen::Vector3f& o = state.camera_offset_B;
+  if (!o.isZero(0.f)) {  // a head camera's pose stays exactly as it always was
+    const float c = std::cos(state.heading_rad), s = std::sin(state.heading_rad);
+    T_W_C.translation() += Eigen::Vector3f(c * o.x() - s * o.y(), s * o.x() + c * o.y(), o.z());
+  }
   return T_W_C;
+}
+
+Eigen::Vector3f ArmOffset(float camera_height_m, const Eigen::Vector2f& offset_m,
+                          float head_height_m) {
+  return {offset_m.x(), offset_m.y(), camera_height_m - head_height_m};
+}
+
+std::string ArmWorkspaceProblem(const ArmParams& arm, float camera_height_m,
+                                const Eigen::Vector2f& offset_m) {
+  constexpr float kSlack = 1e-4f;  // float round trips through the ABI
+  const auto num = [](float v) {
+    std::ostringstream s;
+    s.precision(3);
+    s << v;
+    return s.str();
+  };
+  if (!std::isfinite(camera_height_m) || !offset_m.allFinite()) return "not finite";
+  if (camera_height_m < arm.height_min_m - kSlack || camera_height_m > arm.height_max_m + kSlack)
+    return "camera height " + num(camera_height_m) + " m outside the arm's [" +
+           num(arm.height_min_m) + ", " + num(arm.height_max_m) + "] m";
+  const float reach = offset_m.norm();
+  if (reach < arm.reach_min_m - kSlack || reach > arm.reach_max_m + kSlack)
+    return "camera reach " + num(reach) + " m outside the arm's [" + num(arm.reach_min_m) + ", " +
+           num(arm.reach_max_m) + "] m";
+  const float bearing_deg =
+      reach > 0.f ? std::atan2(offset_m.y(), offset_m.x()) * 180.f / kPi : 0.f;
+  if (std::abs(bearing_deg) > arm.reach_half_angle_deg + 1e-2f)
+    return "camera bearing " + num(bearing_deg) + " deg beyond the arm's +-" +
+           num(arm.reach_half_angle_deg) + " deg";
+  return "";
 }
 
 PinholeCamera CameraWithFov(int width, int height, float horizontal_fov_deg) {
@@ -169,14 +241,50 @@ Result<Robot> Robot::Create(const RobotParams& params, FloorPlan plan, const Rob
     return InvalidArgument("Robot: start " + Point(start.position_W) + " with radius " +
                            std::to_string(params.radius_m) +
                            " m overlaps an obstacle or lies outside the floor plan");
-  if (std::abs(start.camera_pitch_rad) > Deg2Rad(params.max_abs_pitch_deg))
-    return InvalidArgument("Robot: start camera pitch beyond max_abs_pitch_deg");
   Robot robot;
   robot.params_ = params;
   robot.plan_ = std::move(plan);
   robot.state_ = start;
   robot.mode_ = mode;
+  if (std::abs(start.camera_pitch_rad) > robot.max_abs_pitch_rad())
+    return InvalidArgument("Robot: start camera pitch beyond the mode's limit");
+  robot.state_.camera_offset_B = robot.RestOffset();
   return robot;
+}
+
+float Robot::max_abs_pitch_rad() const {
+  const ModeParams& m = mode_params();
+  return Deg2Rad(m.mount == MountKind::kArm ? m.arm.max_abs_pitch_deg : params_.max_abs_pitch_deg);
+}
+
+Eigen::Vector3f Robot::RestOffset() const {
+  const ModeParams& m = mode_params();
+  if (m.mount == MountKind::kHead) return Eigen::Vector3f::Zero();
+  const float h = std::clamp(params_.camera_height_m, m.arm.height_min_m, m.arm.height_max_m);
+  return ArmOffset(h, {m.arm.reach_min_m, 0.f}, params_.camera_height_m);
+}
+
+void Robot::SetMode(RobotMode mode) {
+  if (mode == mode_) return;
+  mode_ = mode;
+  ++switches_;
+  clock_s_ += mode_params().switch_s;
+  state_.camera_offset_B = RestOffset();
+  const float limit = max_abs_pitch_rad();
+  state_.camera_pitch_rad = std::clamp(state_.camera_pitch_rad, -limit, limit);
+}
+
+Status Robot::SetArmCamera(float camera_height_m, const Eigen::Vector2f& offset_m) {
+  const ModeParams& m = mode_params();
+  if (m.mount != MountKind::kArm)
+    return InvalidArgument("Robot::SetArmCamera: the " + std::string(RobotModeName(mode_)) +
+                           " camera is on a head");
+  if (const std::string why = ArmWorkspaceProblem(m.arm, camera_height_m, offset_m); !why.empty())
+    return InvalidArgument("Robot::SetArmCamera: " + why);
+  const Eigen::Vector3f target = ArmOffset(camera_height_m, offset_m, params_.camera_height_m);
+  clock_s_ += (target - state_.camera_offset_B).norm() / m.arm.speed_mps;
+  state_.camera_offset_B = target;
+  return Status::Ok();
 }
 
 void Robot::TurnTo(float heading_rad) {
@@ -208,10 +316,10 @@ void Robot::SetCameraYaw(float yaw_rad) {
 void Robot::WrapCameraYaw() { state_.camera_yaw_rad = WrapAngle(state_.camera_yaw_rad); }
 
 Status Robot::SetCameraPitch(float pitch_rad) {
-  if (!(std::abs(pitch_rad) <= Deg2Rad(params_.max_abs_pitch_deg)))
+  if (!(std::abs(pitch_rad) <= max_abs_pitch_rad()))
     return InvalidArgument("Robot::SetCameraPitch: " + std::to_string(pitch_rad * 180.f / kPi) +
                            " deg is beyond the limit of " +
-                           std::to_string(params_.max_abs_pitch_deg) + " deg");
+                           std::to_string(max_abs_pitch_rad() * 180.f / kPi) + " deg");
   clock_s_ += std::abs(pitch_rad - state_.camera_pitch_rad) / params_.camera_pitch_rate_radps;
   state_.camera_pitch_rad = pitch_rad;
   return Status::Ok();

@@ -22,6 +22,23 @@ inline float Deg2Rad(float deg) { return deg * std::numbers::pi_v<float> / 180.f
 enum class RobotMode { kExplorer, kReconstructor };
 const char* RobotModeName(RobotMode mode);  // "explorer", "reconstructor"
 
+// Where a mode's camera sits. A head: over the base centre at RobotParams::camera_height_m,
+// tilting within RobotParams::max_abs_pitch_deg. An arm (Guo 2022's reconstructor, a 7-DOF arm
+// holding the camera): anywhere in ArmParams' workspace around the base.
+enum class MountKind { kHead, kArm };
+const char* MountKindName(MountKind mount);  // "head", "arm"
+
+// The arm's workspace. Guo gives none ("within the reachable range of the robot's arm"); these
+// are a Fetch-sized arm's: the camera 0.4-1.5 m above the floor, 0.3-0.8 m from the base centre
+// at a bearing within +-90 deg of the heading, pitched anywhere in +-90 deg (the paper's phi).
+struct ArmParams {
+  float height_min_m = 0.4f, height_max_m = 1.5f;
+  float reach_min_m = 0.3f, reach_max_m = 0.8f;
+  float reach_half_angle_deg = 90.f;
+  float max_abs_pitch_deg = 90.f;
+  float speed_mps = 0.25f;  // the camera along the arm
+};
+
 // What a mode changes: speeds and the sensor's field of view and range.
 struct ModeParams {
   float max_speed_mps = 0.5f;
@@ -32,8 +49,13 @@ struct ModeParams {
   // gathers more); 0: captured by displacement (FusionTrigger) and once per view. At most
   // kMaxCaptureHz.
   float capture_hz = 0.0f;
+  MountKind mount = MountKind::kHead;
+  ArmParams arm;             // with mount kArm
+  float min_range_m = 0.1f;  // nearer depth is not fused
+  float switch_s = 0.f;      // switching into this mode (stowing or unstowing the arm)
 };
 inline constexpr float kMaxCaptureHz = 60.0f;
+inline constexpr float kMaxSwitchS = 600.0f;
 ModeParams DefaultModeParams(RobotMode mode);
 
 struct RobotParams {
@@ -58,10 +80,21 @@ struct RobotState {
   float heading_rad = 0.f;                               // base θ, from world +x towards +y
   float camera_yaw_rad = 0.f;    // joint angle relative to the base (unwrapped)
   float camera_pitch_rad = 0.f;  // positive looks up
+  // The optical centre's offset from the head position (the base centre at camera_height_m),
+  // in the base frame (x forward, y left, z up); zero for a head mount.
+  Eigen::Vector3f camera_offset_B = Eigen::Vector3f::Zero();
 };
 
 // Camera-to-world pose of the camera (OpenCV axes: x right, y down, z forward) for a state.
 Pose3f CameraPoseFromState(const RobotState& state, float camera_height_m);
+
+// The arm camera's place in the base frame for a height above the floor and a horizontal offset
+// (forward, left) from the base centre, as RobotState::camera_offset_B; and whether it lies in
+// the workspace (empty string) or why not.
+Eigen::Vector3f ArmOffset(float camera_height_m, const Eigen::Vector2f& offset_m,
+                          float head_height_m);
+std::string ArmWorkspaceProblem(const ArmParams& arm, float camera_height_m,
+                                const Eigen::Vector2f& offset_m);
 // Square-pixel camera with the given horizontal field of view, principal point at the centre.
 PinholeCamera CameraWithFov(int width, int height, float horizontal_fov_deg);
 
@@ -91,7 +124,18 @@ class Robot {
   double clock_s() const { return clock_s_; }
   double distance_m() const { return distance_m_; }
 
-  void SetMode(RobotMode mode) { mode_ = mode; }
+  // Switching into another mode costs its switch_s and puts the camera at the new mount's rest
+  // pose (the arm: nearest reach straight ahead at the head's height, clamped to its range), its
+  // pitch within the new limit. The same mode: nothing.
+  void SetMode(RobotMode mode);
+  // The arm camera to a height and horizontal offset (ArmOffset); costs the distance at the
+  // arm's speed. Refused (state and clock unchanged) outside the workspace or on a head mount.
+  Status SetArmCamera(float camera_height_m, const Eigen::Vector2f& offset_m);
+  // The current mode's pitch limit.
+  float max_abs_pitch_rad() const;
+  // The current mode's camera at rest (RobotState::camera_offset_B).
+  Eigen::Vector3f RestOffset() const;
+  size_t switches() const { return switches_; }
   // Turns the base in place to `heading_rad` the short way; costs |Δθ| / turn rate.
   void TurnTo(float heading_rad);
   // Turns towards the goal, then drives straight at the mode's speed. Refuses (state and clock
@@ -117,6 +161,7 @@ class Robot {
   RobotMode mode_ = RobotMode::kExplorer;
   double clock_s_ = 0.0;
   double distance_m_ = 0.0;
+  size_t switches_ = 0;
 };
 
 // Fires for the first pose, then whenever the camera has moved more than min_translation_m or

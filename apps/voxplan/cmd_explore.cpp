@@ -52,6 +52,7 @@ struct ExploreOptions {
   double max_range_m = DefaultModeParams(RobotMode::kExplorer).max_range_m;
   bool no_noise = false;
   bool no_labels = false;
+  bool no_detector_noise = false;
   bool no_color = false;
   bool no_clear = false;
   double fuse_step_m = 0.25, fuse_step_deg = 15.0;
@@ -171,6 +172,7 @@ ExploreRunParams RunParams(const ExploreOptions& o, std::vector<Eigen::Vector2f>
   params.max_memory_bytes = MemoryBudgetBytes(o.memory);
   params.noise = !o.no_noise;
   params.fuse_labels = !o.no_labels;
+  params.detector.noise = !o.no_detector_noise;
   params.fuse_color = !o.no_color;
   params.clear_beyond_range = !o.no_clear;
   params.trigger = {float(o.fuse_step_m), float(o.fuse_step_deg)};
@@ -293,6 +295,9 @@ Command AddExploreCommand(CLI::App& app) {
                 "Depth beyond --max-range-m clears nothing (by default it clears the free space in "
                 "front of the range, as a real sensor's far returns show it)");
   sub->add_flag("--no-labels", o->no_labels, "Fuse no instance labels (no object map)");
+  sub->add_flag("--no-detector-noise", o->no_detector_noise,
+                "Fuse the simulator's instance labels as they are (by default a detector model "
+                "drops, erodes, merges and size-filters them per frame: sim/detector.h)");
   sub->add_flag("--no-color", o->no_color,
                 "Render and fuse no colour (a grey mesh.ply; the metrics do not change)");
   positive("--planning-interval", run.explore.planning_interval_s,

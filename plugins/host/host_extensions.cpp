@@ -52,6 +52,39 @@ const vp_objects_ext kObjects = {
     .get_instance_surface = GetInstanceSurface,
 };
 
+// ---- vp.task 1. -------------------------------------------------------------------------------
+
+vp_status AddTaskExt(vp_plan_output* o, uint32_t robot, const vp_task* task,
+                     const vp_task_ext* ext) {
+  return Guarded([&]() -> vp_status {
+    if (!o || robot >= o->result->robots.size() || !task) return VP_ERROR_INVALID_ARGUMENT;
+    // Its first field says how much of the struct the plugin knows.
+    if (ext && ext->struct_size < sizeof(uint32_t)) return VP_ERROR_STRUCT_SIZE;
+    RobotPlan& plan = o->result->robots[robot];
+    if (plan.tasks.size() >= kMaxTasksPerRobot) return VP_ERROR_LIMIT;
+    PlannerTask t = FromC(*task);
+    if (ext) t.camera = FromC(*ext, ext->struct_size);
+    plan.tasks.push_back(t);  // validated after plan() returns
+    return VP_OK;
+  });
+}
+
+vp_status GetRobotQueueExt(const vp_world* w, uint32_t robot, const vp_task_ext** out,
+                           uint32_t* count) {
+  return Guarded([&]() -> vp_status {
+    if (!w || !out || !count || robot >= w->queue_exts.size()) return VP_ERROR_INVALID_ARGUMENT;
+    *out = w->queue_exts[robot].data();
+    *count = uint32_t(w->queue_exts[robot].size());
+    return VP_OK;
+  });
+}
+
+const vp_task_ext_table kTask = {
+    .header = {.struct_size = sizeof(vp_task_ext_table), .version = 1},
+    .add_task_ext = AddTaskExt,
+    .get_robot_queue_ext = GetRobotQueueExt,
+};
+
 // ---- The registry. ----------------------------------------------------------------------------
 
 struct Extension {
@@ -61,9 +94,31 @@ struct Extension {
 
 constexpr Extension kExtensions[] = {
     {VP_EXT_OBJECTS, &kObjects.header},
+    {VP_EXT_TASK, &kTask.header},
 };
 
 }  // namespace
+
+TaskCamera FromC(const vp_task_ext& e, uint32_t size) {
+  TaskCamera c;
+  // Fields past what the plugin's struct holds keep their defaults.
+  const auto has = [&](const auto& field) {
+    return size >=
+           uint32_t(reinterpret_cast<const char*>(&field) - reinterpret_cast<const char*>(&e)) +
+               uint32_t(sizeof(field));
+  };
+  if (has(e.camera_height_m)) c.height_m = e.camera_height_m;
+  if (has(e.camera_offset_m)) c.offset_m = {e.camera_offset_m[0], e.camera_offset_m[1]};
+  if (has(e.look_at)) c.look_at = e.look_at != 0;
+  if (has(e.look_at_W)) c.look_at_W = {e.look_at_W[0], e.look_at_W[1], e.look_at_W[2]};
+  if (has(e.sweep_pitch_step_rad)) {
+    c.sweep_pitch_min_rad = e.sweep_pitch_min_rad;
+    c.sweep_pitch_max_rad = e.sweep_pitch_max_rad;
+    c.sweep_pitch_step_rad = e.sweep_pitch_step_rad;
+  }
+  if (has(e.object_id)) c.object_id = e.object_id;
+  return c;
+}
 
 const vp_extension_header* GetExtension(const char* name, uint32_t min_version) {
   if (name == nullptr) return nullptr;

@@ -28,6 +28,7 @@ struct vp_world {
   mutable std::vector<std::vector<float>> buffers;  // fields, matrices, paths; never reused
   std::vector<voxplan::PlannerRobot> robots;
   std::vector<std::vector<vp_task>> queues;
+  std::vector<std::vector<vp_task_ext>> queue_exts;  // the same tasks' camera parts
   // Host functions inside `world` now; kRevoked added once the host gave the plugin up.
   mutable std::atomic<int> gate{0};
 };
@@ -41,6 +42,17 @@ struct vp_plan_output {
 namespace voxplan::internal {
 
 inline constexpr int kRevoked = 1 << 30;
+inline constexpr size_t kMaxTasksPerRobot = 100000;  // per robot and plan call
+
+// A host function's body: an exception (bad_alloc, a throwing PlannerWorld) becomes a status.
+template <class F>
+vp_status Guarded(F&& f) noexcept {
+  try {
+    return f();
+  } catch (...) {
+    return VP_ERROR_INTERNAL;
+  }
+}
 
 // One host function's use of w->world: ok() is false once the host revoked the handle.
 class WorldEntry {
@@ -85,6 +97,24 @@ inline PlannerTask FromC(const vp_task& t) {
   p.tag = t.tag;
   return p;
 }
+
+inline vp_task_ext ToC(const TaskCamera& c) {
+  vp_task_ext e{};
+  e.struct_size = sizeof(e);
+  e.camera_height_m = c.height_m;
+  e.camera_offset_m[0] = c.offset_m.x();
+  e.camera_offset_m[1] = c.offset_m.y();
+  e.look_at = c.look_at ? 1 : 0;
+  for (int k = 0; k < 3; ++k) e.look_at_W[k] = c.look_at_W[k];
+  e.sweep_pitch_min_rad = c.sweep_pitch_min_rad;
+  e.sweep_pitch_max_rad = c.sweep_pitch_max_rad;
+  e.sweep_pitch_step_rad = c.sweep_pitch_step_rad;
+  e.object_id = c.object_id;
+  return e;
+}
+// A plugin's vp_task_ext of `size` bytes (it may be older and shorter): what it lacks keeps the
+// defaults.
+TaskCamera FromC(const vp_task_ext& e, uint32_t size);
 
 inline bool AllFinite(std::initializer_list<float> values) {
   for (float v : values) {

@@ -29,24 +29,16 @@ using internal::AllFinite;
 using internal::ElapsedS;
 using internal::FromC;
 using internal::GetExtension;
+using internal::Guarded;
+using internal::kMaxTasksPerRobot;
 
 // Caps on what one plan may return, so a runaway plugin cannot exhaust memory.
-constexpr size_t kMaxTasksPerRobot = 100000;
 constexpr size_t kMaxPathPoints = 1000000;
 constexpr size_t kMaxDiagnostics = 100000;
 constexpr size_t kMaxDebugPoints = 5000000;
 constexpr uint32_t kMaxMatrixPoints = 4096;
 constexpr size_t kMaxNameChars = 256;
 constexpr size_t kMaxTextChars = 4096;
-
-template <class F>
-vp_status Guarded(F&& f) noexcept {
-  try {
-    return f();
-  } catch (...) {  // bad_alloc or a throwing PlannerWorld: the plugin gets a status instead
-    return VP_ERROR_INTERNAL;
-  }
-}
 
 // Guarded, and only while the host has not revoked the world: a plugin the host gave up on may
 // still run, and the world it was shown may be gone.

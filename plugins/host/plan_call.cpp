@@ -93,8 +93,13 @@ Result<PlanResult> LoadedPlanner::Plan(const PlannerWorld& world, const PlanRequ
   }
   for (const PlannerRobot& r : w.robots) {
     std::vector<vp_task> queue;
-    for (const PlannerTask& t : r.queue) queue.push_back(ToC(t));
+    std::vector<vp_task_ext> exts;
+    for (const PlannerTask& t : r.queue) {
+      queue.push_back(ToC(t));
+      exts.push_back(ToC(t.camera));
+    }
     w.queues.push_back(std::move(queue));
+    w.queue_exts.push_back(std::move(exts));
   }
   result.robots.resize(w.robots.size());
   state->out.result = &result;

@@ -7,7 +7,9 @@
 //
 // Frames and units as in planner_api.h: world Z up, metres, radians; yaw from +x towards +y.
 #include <Eigen/Core>
+#include <cmath>
 #include <cstdint>
+#include <limits>
 #include <span>
 #include <string>
 #include <vector>
@@ -78,6 +80,23 @@ struct PlannerFloor {
 enum class TaskPolicy : int32_t { kAppend = 0, kReplace = 1 };
 enum class PlanEvent : int32_t { kStart = 0, kInterval = 1, kRobotIdle = 2, kTaskFailed = 3 };
 
+// Where the camera is at a task (vp_task_ext, extension vp.task); the defaults leave it where
+// the mount puts it.
+struct TaskCamera {
+  float height_m = std::numeric_limits<float>::quiet_NaN();  // arm: above the floor; NaN rest
+  Eigen::Vector2f offset_m = Eigen::Vector2f::Constant(std::numeric_limits<float>::quiet_NaN());
+  bool look_at = false;
+  Eigen::Vector3f look_at_W = Eigen::Vector3f::Zero();
+  float sweep_pitch_min_rad = 0.f, sweep_pitch_max_rad = 0.f, sweep_pitch_step_rad = 0.f;
+  int32_t object_id = -1;
+
+  // Anything but NaN counts as given (and infinities are then refused).
+  bool HeightSet() const { return !std::isnan(height_m); }
+  bool OffsetSet() const { return !std::isnan(offset_m.x()) || !std::isnan(offset_m.y()); }
+  bool ArmSet() const { return HeightSet() || OffsetSet(); }
+  bool Sweeps() const { return sweep_pitch_step_rad > 0.f; }
+};
+
 // A view to drive to and scan from (mode and dwell as in sim/robot.h).
 struct PlannerTask {
   Eigen::Vector2f position_m = Eigen::Vector2f::Zero();
@@ -87,6 +106,7 @@ struct PlannerTask {
   float dwell_s = 0.f;
   int32_t mode = 0;
   uint32_t tag = 0;  // the plugin's own id
+  TaskCamera camera;
 };
 
 // Where a mode's camera sits (VP_MOUNT_*): the base centre, a head at a fixed height with a tilt,

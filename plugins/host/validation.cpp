@@ -33,8 +33,12 @@ std::string TaskProblem(const PlannerTask& t, const PlannerRobot& robot, const P
   if (t.mode < 0 || size_t(t.mode) >= modes) {
     return "mode " + std::to_string(t.mode) + " unknown (robot has " + std::to_string(modes) + ")";
   }
-  if (t.camera_pitch_rad < robot.min_pitch_rad || t.camera_pitch_rad > robot.max_pitch_rad) {
-    return "camera pitch " + fmt(t.camera_pitch_rad) + " rad outside the robot's limits";
+  // The mode's own pitch range (an arm tilts further than a head).
+  const ScanMode* mode = robot.modes.empty() ? nullptr : &robot.modes[size_t(t.mode)];
+  const float min_pitch = mode ? mode->min_pitch_rad : robot.min_pitch_rad;
+  const float max_pitch = mode ? mode->max_pitch_rad : robot.max_pitch_rad;
+  if (t.camera_pitch_rad < min_pitch || t.camera_pitch_rad > max_pitch) {
+    return "camera pitch " + fmt(t.camera_pitch_rad) + " rad outside the mode's limits";
   }
   const std::string at = " at (" + fmt(t.position_m.x()) + ", " + fmt(t.position_m.y()) + ")";
   if ((t.position_m.array() < map.bounds_min.head<2>().array()).any() ||
@@ -54,6 +58,67 @@ std::string TaskProblem(const PlannerTask& t, const PlannerRobot& robot, const P
   if (field.size() != floor.cells.size() || !std::isfinite(field[i])) {
     return "unreachable from the robot" + at;
   }
+  return "";
+}
+
+// The camera part of a task (vp.task): "" when the mode can take it.
+std::string TaskCameraProblem(const PlannerTask& t, const PlannerRobot& robot,
+                              const PlannerWorld& world) {
+  const TaskCamera& c = t.camera;
+  const auto fmt = [](float x) {
+    char buf[32];
+    std::snprintf(buf, sizeof buf, "%.3g", double(x));
+    return std::string(buf);
+  };
+  constexpr float kSlack = 1e-4f;  // float round trips
+  constexpr int kMaxSweepSteps = 64;
+  if (c.look_at && !c.look_at_W.allFinite()) return "look-at point is not finite";
+  if (!AllFinite({c.sweep_pitch_min_rad, c.sweep_pitch_max_rad, c.sweep_pitch_step_rad}))
+    return "pitch sweep is not finite";
+  const ScanMode* mode = robot.modes.empty() ? nullptr : &robot.modes[size_t(t.mode)];
+  if (c.Sweeps()) {
+    const float lo = mode ? mode->min_pitch_rad : robot.min_pitch_rad;
+    const float hi = mode ? mode->max_pitch_rad : robot.max_pitch_rad;
+    if (c.sweep_pitch_min_rad > c.sweep_pitch_max_rad || c.sweep_pitch_min_rad < lo - kSlack ||
+        c.sweep_pitch_max_rad > hi + kSlack)
+      return "pitch sweep [" + fmt(c.sweep_pitch_min_rad) + ", " + fmt(c.sweep_pitch_max_rad) +
+             "] rad outside the mode's limits";
+    if ((c.sweep_pitch_max_rad - c.sweep_pitch_min_rad) / c.sweep_pitch_step_rad > kMaxSweepSteps)
+      return "pitch sweep has more than " + std::to_string(kMaxSweepSteps) + " steps";
+  } else if (c.sweep_pitch_step_rad < 0.f) {
+    return "pitch sweep step is negative";
+  }
+  if (!c.ArmSet()) return "";
+  if (!mode || mode->mount != CameraMount::kArm)
+    return "camera height or offset given for a mode without an arm";
+  const float height = c.HeightSet() ? c.height_m
+                                     : std::clamp(robot.camera_height_m, mode->camera_height_min_m,
+                                                  mode->camera_height_max_m);
+  const Eigen::Vector2f offset =
+      c.OffsetSet() ? c.offset_m : Eigen::Vector2f(mode->reach_min_m, 0.f);
+  if (!std::isfinite(height) || !offset.allFinite()) return "camera height or offset is not finite";
+  if (height < mode->camera_height_min_m - kSlack || height > mode->camera_height_max_m + kSlack)
+    return "camera height " + fmt(height) + " m outside the arm's [" +
+           fmt(mode->camera_height_min_m) + ", " + fmt(mode->camera_height_max_m) + "] m";
+  const float reach = offset.norm();
+  if (reach < mode->reach_min_m - kSlack || reach > mode->reach_max_m + kSlack)
+    return "camera reach " + fmt(reach) + " m outside the arm's [" + fmt(mode->reach_min_m) + ", " +
+           fmt(mode->reach_max_m) + "] m";
+  const float bearing = reach > 0.f ? std::atan2(offset.y(), offset.x()) : 0.f;
+  if (std::abs(bearing) > mode->reach_half_angle_rad + kSlack)
+    return "camera bearing " + fmt(bearing) + " rad beyond the arm's +-" +
+           fmt(mode->reach_half_angle_rad) + " rad";
+  // Where the camera will be: in observed free space, not in a wall or in the unknown.
+  const float cs = std::cos(t.theta_rad), sn = std::sin(t.theta_rad);
+  const Eigen::Vector3f camera_W(t.position_m.x() + cs * offset.x() - sn * offset.y(),
+                                 t.position_m.y() + sn * offset.x() + cs * offset.y(), height);
+  VoxelState state = VoxelState::kUnobserved;
+  world.VoxelStates(std::span<const Eigen::Vector3f>(&camera_W, 1),
+                    std::span<VoxelState>(&state, 1));
+  if (state != VoxelState::kFree)
+    return std::string("camera position ") +
+           (state == VoxelState::kOccupied ? "inside a surface" : "in unobserved space") + " at (" +
+           fmt(camera_W.x()) + ", " + fmt(camera_W.y()) + ", " + fmt(camera_W.z()) + ")";
   return "";
 }
 
@@ -83,7 +148,8 @@ void Validate(const PlannerWorld& world, const std::vector<PlannerRobot>& robots
     }
     std::vector<PlannerTask> kept;
     for (size_t t = 0; t < plan.tasks.size(); ++t) {
-      const std::string problem = TaskProblem(plan.tasks[t], robot, map, floor, field, v);
+      std::string problem = TaskProblem(plan.tasks[t], robot, map, floor, field, v);
+      if (problem.empty()) problem = TaskCameraProblem(plan.tasks[t], robot, world);
       if (problem.empty()) {
         kept.push_back(plan.tasks[t]);
       } else {

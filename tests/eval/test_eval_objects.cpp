@@ -143,6 +143,32 @@ TEST(EvaluateObjects, ShiftAlongTheNormalIsTheObjectAccuracy) {
             result->reconstruction_samples);
 }
 
+TEST(EvaluateObjects, ExtraThresholdsReportCompletenessFromTheSameSamples) {
+  // The panels of the test above, 2 cm and 4 cm off: within 1 cm neither, within 3 cm the first,
+  // within 5 cm both; the primary threshold's numbers are those of a run without extras.
+  World world;
+  Append(Rectangle(0.f, 0.f, 1.f, 1.f, 0.5f), 1, &world.mesh, &world.triangle_instance);
+  Append(Rectangle(3.f, 0.f, 4.f, 1.f, 0.8f), 2, &world.mesh, &world.triangle_instance);
+  world.instances = {MakeInstance(1, "table"), MakeInstance(2, "table")};
+  Mesh recon;
+  Append(Rectangle(0.f, 0.f, 1.f, 1.f, 0.52f), 0, &recon, nullptr);
+  Append(Rectangle(3.f, 0.f, 4.f, 1.f, 0.84f), 0, &recon, nullptr);
+  ObjectEvalParams params = Params(0.03f);
+  params.extra_thresholds_m = {0.01f, 0.05f};
+  auto result = EvaluateObjects(recon, world, params);
+  ASSERT_TRUE(result.ok()) << result.status().message();
+  ASSERT_EQ(result->o_comp_extra.size(), 2u);
+  ASSERT_EQ(result->objects[0].completeness_extra.size(), 2u);
+  EXPECT_DOUBLE_EQ(result->objects[0].completeness_extra[0], 0.0);
+  EXPECT_DOUBLE_EQ(result->objects[0].completeness_extra[1], 1.0);
+  EXPECT_DOUBLE_EQ(result->objects[1].completeness_extra[1], 1.0);
+  EXPECT_DOUBLE_EQ(result->o_comp_extra[0], 0.0);
+  EXPECT_DOUBLE_EQ(result->o_comp_extra[1], 1.0);
+  EXPECT_DOUBLE_EQ(result->o_comp, 0.5);
+  params.extra_thresholds_m = {-0.01f};
+  EXPECT_FALSE(EvaluateObjects(recon, world, params).ok());
+}
+
 TEST(EvaluateObjects, UnseenObjectCountsInCompletenessButNotInAccuracy) {
   World world;
   Append(Rectangle(0.f, 0.f, 1.f, 1.f, 0.5f), 1, &world.mesh, &world.triangle_instance);

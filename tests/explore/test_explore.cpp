@@ -3,6 +3,7 @@
 // reconstructed, it is deterministic, and robots are placed on free floor or refused.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <functional>
 #include <limits>
@@ -254,9 +255,11 @@ TEST(Explore, StartsAreFreeSideBySideAndBadOnesAreRefused) {
   EXPECT_FALSE(run.ok());
 }
 
-std::unique_ptr<LoadedPlanner> Goto(const Eigen::Vector2f& goal_W) {
-  const std::string config =
-      "{\"x\": " + std::to_string(goal_W.x()) + ", \"y\": " + std::to_string(goal_W.y()) + "}";
+// `extra`: more of goto's config keys, e.g. "\"mode\": 1, \"height\": 0.6".
+std::unique_ptr<LoadedPlanner> Goto(const Eigen::Vector2f& goal_W, const std::string& extra = "") {
+  const std::string config = "{\"x\": " + std::to_string(goal_W.x()) +
+                             ", \"y\": " + std::to_string(goal_W.y()) +
+                             (extra.empty() ? "" : ", " + extra) + "}";
   Result<std::unique_ptr<LoadedPlanner>> planner =
       LoadPlanner(VOXPLAN_GOTO_TEST_PLANNER,
                   {.config_json = config, .seed = 1, .search_path = {}, .limits = {}});
@@ -336,6 +339,99 @@ TEST(Explore, PlannersSeeTheExplorerCamera) {
                                      run->plan_calls[0].diagnostics.end());
   EXPECT_NEAR(seen["explorer_fov_rad"], 58.0 * M_PI / 180.0, 1e-6);
   EXPECT_NEAR(seen["explorer_max_range_m"], 3.0, 1e-6);
+}
+
+// The reconstructor on an arm (Guo 2022), switched into at a cost.
+ExploreParams ArmExplore(float switch_s) {
+  ExploreParams params = FastParams();
+  params.max_time_s = 120.0;
+  params.robot.reconstructor.mount = MountKind::kArm;
+  params.robot.reconstructor.switch_s = switch_s;
+  return params;
+}
+
+// A goal 0.6 m from the start along +x or -x whose footprint the true plan leaves free.
+Eigen::Vector2f NearGoal(const Scene& s, const Eigen::Vector2f& start, float radius_m) {
+  for (float dx : {0.6f, -0.6f}) {
+    const Eigen::Vector2f goal = start + Eigen::Vector2f(dx, 0.f);
+    if (SegmentFree(s.plan, start, goal, radius_m + 0.1f)) return goal;
+  }
+  return start;
+}
+
+TEST(Explore, TheArmCameraTakesTheTasksHeightOffsetAndAimAndTheSwitchTakesItsTime) {
+  const Scene& s = SmallApartment();
+  const ExploreParams params = ArmExplore(2.f);
+  const Eigen::Vector2f start =
+      ChooseStarts(s.plan, s.world.rooms, 1, params.robot.radius_m).value()[0];
+  const Eigen::Vector2f goal = NearGoal(s, start, params.robot.radius_m);
+  ASSERT_NE(goal, start);
+  const Eigen::Vector3f look(goal.x() + 2.f * (goal.x() - start.x()), goal.y() + 0.5f, 0.3f);
+  const std::string camera =
+      "\"mode\": 1, \"height\": 0.6, \"offset_x\": 0.5, \"offset_y\": 0.2, "
+      "\"look_x\": " +
+      std::to_string(look.x()) + ", \"look_y\": " + std::to_string(look.y()) +
+      ", \"look_z\": " + std::to_string(look.z());
+  std::unique_ptr<LoadedPlanner> planner = Goto(goal, camera);
+  ASSERT_TRUE(planner);
+  Result<ExploreResult> run = RunExplore(s.world, s.plan, {start}, *planner, params, {});
+  ASSERT_TRUE(run.ok()) << run.status().message();
+  ASSERT_EQ(run->terminated, "done");
+  ASSERT_EQ(run->task_views[0].size(), 1u);
+  // The view's frame: the camera 0.6 m up, at (0.5, 0.2) in the base frame of the task's pose,
+  // its optical axis on the look-at point.
+  const PlannerTask& view = run->task_views[0][0];
+  const float c = std::cos(view.theta_rad), sn = std::sin(view.theta_rad);
+  const Eigen::Vector3f expected(goal.x() + 0.5f * c - 0.2f * sn, goal.y() + 0.5f * sn + 0.2f * c,
+                                 0.6f);
+  constexpr float kPlace_m = 1e-3f, kAim_rad = 0.02f;
+  bool at_view = false;
+  for (const ExploreFrame& f : run->frames[0]) {
+    if ((f.T_W_C.translation() - expected).norm() > kPlace_m) continue;
+    const Eigen::Vector3f axis = f.T_W_C.linear().col(2);
+    const Eigen::Vector3f to = (look - expected).normalized();
+    at_view = at_view || std::acos(std::clamp(axis.dot(to), -1.f, 1.f)) < kAim_rad;
+  }
+  EXPECT_TRUE(at_view);
+  // The same run without the switch's 2 s is 2 s shorter: one switch, into the reconstructor.
+  Result<ExploreResult> free_switch =
+      RunExplore(s.world, s.plan, {start}, *Goto(goal, camera), ArmExplore(0.f), {});
+  ASSERT_TRUE(free_switch.ok()) << free_switch.status().message();
+  EXPECT_NEAR(run->time_s - free_switch->time_s, 2.0, 0.26);  // a loop step: 0.25 s
+}
+
+TEST(Explore, AHeadSweepsItsPitchAtTheViewAndBadCameraPartsAreRejected) {
+  const Scene& s = SmallApartment();
+  ExploreParams params = ArmExplore(0.f);
+  const Eigen::Vector2f start =
+      ChooseStarts(s.plan, s.world.rooms, 1, params.robot.radius_m).value()[0];
+  const Eigen::Vector2f goal = NearGoal(s, start, params.robot.radius_m);
+  std::unique_ptr<LoadedPlanner> planner =
+      Goto(goal, "\"sweep_min\": -0.5, \"sweep_max\": 0.5, \"sweep_step\": 0.25");
+  Result<ExploreResult> run = RunExplore(s.world, s.plan, {start}, *planner, params, {});
+  ASSERT_TRUE(run.ok()) << run.status().message();
+  ASSERT_EQ(run->terminated, "done");
+  // Frames at the view, one per sweep pitch: -0.5, -0.25, 0, 0.25, 0.5.
+  std::vector<float> pitches;
+  for (const ExploreFrame& f : run->frames[0]) {
+    if ((f.T_W_C.translation().head<2>() - goal).norm() > 1e-3f) continue;
+    pitches.push_back(std::asin(f.T_W_C.linear().col(2).z()));
+  }
+  for (float want : {-0.5f, -0.25f, 0.f, 0.25f, 0.5f}) {
+    bool seen = false;
+    for (float p : pitches) seen = seen || std::abs(p - want) < 1e-3f;
+    EXPECT_TRUE(seen) << want;
+  }
+  // Refused: an arm height for the head-mounted explorer; an arm height out of its range; a
+  // sweep past the head's pitch limit. The planner sends them again after each rejection.
+  for (const std::string bad : {"\"height\": 0.6", "\"mode\": 1, \"height\": 2.5",
+                                "\"sweep_min\": -1.5, \"sweep_max\": 0, \"sweep_step\": 0.5"}) {
+    Result<ExploreResult> refused =
+        RunExplore(s.world, s.plan, {start}, *Goto(goal, bad), params, {});
+    ASSERT_TRUE(refused.ok()) << refused.status().message();
+    EXPECT_GE(refused->rejected_tasks, 1u) << bad;
+    EXPECT_TRUE(refused->task_views[0].empty()) << bad;
+  }
 }
 
 // One frame of the small apartment from the first start, fused into `map` and `floor`.

@@ -95,8 +95,9 @@ TEST(ExploreRun, ShortRunWritesEveryArtefactAndItsMetricsAgree) {
   EXPECT_EQ(m, nlohmann::json::parse(RunMetricsJson(params, *report)));
   nlohmann::json summary = nlohmann::json::parse(RunSummaryJson(params, *report));
   EXPECT_EQ(summary["tour_frames"], report->tour_frames);
-  for (const char* key : {"setup_ms", "tour_frames", "render_ms", "noise_ms", "fuse_ms", "floor_ms",
-                          "plan_ms_total", "series_ms", "loop_ms", "eval_ms"})
+  for (const char* key :
+       {"setup_ms", "tour_frames", "render_ms", "detect_ms", "noise_ms", "fuse_ms", "floor_ms",
+        "plan_ms_total", "series_ms", "loop_ms", "eval_ms"})
     EXPECT_EQ(summary.erase(key), 1u) << key;
   EXPECT_EQ(summary, m);
   EXPECT_EQ(m["scene"], "apartment:size=S,seed=1");
@@ -116,6 +117,20 @@ TEST(ExploreRun, ShortRunWritesEveryArtefactAndItsMetricsAgree) {
   EXPECT_NEAR(m["completeness"].get<double>(), report->quality.completeness, 5e-5);
   EXPECT_NEAR(m["distance_total_m"].get<double>(), report->metrics.distance_total_m, 5e-4);
   EXPECT_NE(m["completeness_reference"].get<std::string>().find("sim tour"), std::string::npos);
+  // Per object (Guo 2022): the apartment's furniture, a looser threshold covers more.
+  ASSERT_TRUE(report->objects.has_value());
+  EXPECT_GT(m["objects_evaluated"].get<int>(), 5);
+  EXPECT_LE(m["objects_reconstructed"].get<int>(), m["objects_evaluated"].get<int>());
+  EXPECT_GT(m["o_comp_2cm"].get<double>(), 0.0);
+  EXPECT_LT(m["o_comp_2cm"].get<double>(), m["o_comp_5cm"].get<double>());
+  EXPECT_GT(m["o_rms_m"].get<double>(), 0.0);
+  EXPECT_LT(m["o_rms_m"].get<double>(), 0.05);  // a 5 cm map's mesh, noisy depth
+  EXPECT_GT(m["objects_detected"].get<int>(), 0);
+  const std::vector<std::string> objects = Lines(dir / "out" / "objects.csv");
+  ASSERT_EQ(objects.size(), m["objects_evaluated"].get<size_t>() + 1);
+  EXPECT_EQ(objects[0].rfind("id,class,model,", 0), 0u);
+  for (const ObjectEvalResult& o : report->objects->objects)
+    EXPECT_NE(o.class_name, "wall");  // structure is not an object
 
   // The tables: a header and one row per plan call; every robot's poses in the run log.
   EXPECT_EQ(Lines(dir / "out" / "plan_calls.csv").size(), loop.plan_calls.size() + 1);

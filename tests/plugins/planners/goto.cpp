@@ -1,26 +1,57 @@
 // A planner for the exploration loop's host tests: sends robot 0 to one goal ("x", "y" in the
 // JSON config, read naively), again after every failure, without a path (the host routes it);
 // done once the robot stands there. Reports the explorer camera it was shown as diagnostics.
+// Optional keys give the task a mode ("mode"), a dwell ("dwell") and a camera part (vp.task):
+// "height", "offset_x"/"offset_y" (arm), "look_x"/"look_y"/"look_z", "sweep_min"/"sweep_max"/
+// "sweep_step" (radians).
 #include <cmath>
 #include <cstdlib>
+#include <limits>
 #include <string>
 
 #include "plugins/planner_cpp.h"
 
 namespace {
 
-float NumberOption(const std::string& json, const std::string& key) {
+float OptionalNumber(const std::string& json, const std::string& key) {
   const size_t at = json.find("\"" + key + "\"");
-  if (at == std::string::npos) throw vp::Error(VP_ERROR_INVALID_ARGUMENT, "goto needs " + key);
+  if (at == std::string::npos) return std::numeric_limits<float>::quiet_NaN();
   const size_t colon = json.find(':', at);
   if (colon == std::string::npos) throw vp::Error(VP_ERROR_INVALID_ARGUMENT, "goto: bad " + key);
   return std::strtof(json.c_str() + colon + 1, nullptr);
 }
 
+float NumberOption(const std::string& json, const std::string& key) {
+  const float v = OptionalNumber(json, key);
+  if (std::isnan(v)) throw vp::Error(VP_ERROR_INVALID_ARGUMENT, "goto needs " + key);
+  return v;
+}
+
 class Goto : public vp::Planner {
  public:
   explicit Goto(const vp::Config& config)
-      : x_m_(NumberOption(config.json, "x")), y_m_(NumberOption(config.json, "y")) {}
+      : x_m_(NumberOption(config.json, "x")), y_m_(NumberOption(config.json, "y")) {
+    const std::string& j = config.json;
+    const float mode = OptionalNumber(j, "mode"), dwell = OptionalNumber(j, "dwell");
+    mode_ = std::isnan(mode) ? VP_MODE_EXPLORER : int32_t(mode);
+    dwell_s_ = std::isnan(dwell) ? 0.f : dwell;
+    ext_ = vp::DefaultTaskExt();
+    ext_.camera_height_m = OptionalNumber(j, "height");
+    ext_.camera_offset_m[0] = OptionalNumber(j, "offset_x");
+    ext_.camera_offset_m[1] = OptionalNumber(j, "offset_y");
+    const float look[3] = {OptionalNumber(j, "look_x"), OptionalNumber(j, "look_y"),
+                           OptionalNumber(j, "look_z")};
+    ext_.look_at = std::isnan(look[0]) ? 0 : 1;
+    for (int k = 0; k < 3; ++k) ext_.look_at_W[k] = ext_.look_at ? look[k] : 0.f;
+    const float step = OptionalNumber(j, "sweep_step");
+    if (!std::isnan(step)) {
+      ext_.sweep_pitch_min_rad = OptionalNumber(j, "sweep_min");
+      ext_.sweep_pitch_max_rad = OptionalNumber(j, "sweep_max");
+      ext_.sweep_pitch_step_rad = step;
+    }
+    with_ext_ = !std::isnan(ext_.camera_height_m) || !std::isnan(ext_.camera_offset_m[0]) ||
+                ext_.look_at || ext_.sweep_pitch_step_rad != 0.f;
+  }
 
   void Plan(const vp::WorldView& world, vp::PlanOutput& out) override {
     const vp_mode_params camera = world.Mode(0, VP_MODE_EXPLORER);
@@ -33,14 +64,21 @@ class Goto : public vp::Planner {
       return;
     }
     const vp_task task{
-        x_m_, y_m_, std::atan2(y_m_ - robot.y_m, x_m_ - robot.x_m), 0.f, 0.f, 0.f, VP_MODE_EXPLORER,
-        0};
+        x_m_, y_m_, std::atan2(y_m_ - robot.y_m, x_m_ - robot.x_m), 0.f, 0.f, dwell_s_, mode_, 0};
     out.ReplaceTasks(0);
-    out.AddTask(0, task);
+    if (with_ext_) {
+      out.AddTask(0, task, ext_);
+    } else {
+      out.AddTask(0, task);
+    }
   }
 
  private:
   float x_m_, y_m_;
+  int32_t mode_ = VP_MODE_EXPLORER;
+  float dwell_s_ = 0.f;
+  vp_task_ext ext_{};
+  bool with_ext_ = false;
 };
 
 }  // namespace
