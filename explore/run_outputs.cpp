@@ -11,9 +11,11 @@
 #include <vector>
 
 #include "core/summary.h"
+#include "explore/robot_config.h"
 #include "io/file_util.h"
 #include "io/image_io.h"
 #include "io/mesh_io.h"
+#include "viewer_offscreen/svg_plot.h"
 #include "viewer_offscreen/top_down.h"
 
 namespace voxplan {
@@ -164,6 +166,37 @@ std::vector<std::string> PlanCallRows(const std::vector<PlanCallRecord>& plan_ca
   return calls;
 }
 
+// timeline.svg: per robot, when it was idle and in which mode it worked (Guo 2022 Fig. 9).
+Status WriteTimeline(const ExploreResult& r, const std::string& path) {
+  TimelineParams tp;
+  tp.title = "Robot modes and idle time";
+  tp.categories = {{"explorer", PackRgb(78, 121, 167)},
+                   {"reconstructor", PackRgb(225, 87, 89)},
+                   {"idle", PackRgb(200, 200, 200)}};
+  std::vector<TimelineRow> rows;
+  bool any = false;
+  for (const RobotTrack& track : r.tracks) {
+    TimelineRow row{track.robot, {}};
+    for (size_t i = 0; i + 1 < track.samples.size(); ++i) {
+      const RobotSample& s = track.samples[i];
+      const int category = s.status == RobotStatus::kIdle ? 2 : s.mode == "reconstructor" ? 1 : 0;
+      const double t1 = track.samples[i + 1].t_s;
+      if (!row.spans.empty() && row.spans.back().category == category &&
+          row.spans.back().t1_s == s.t_s) {
+        row.spans.back().t1_s = t1;  // one span for a run of samples
+      } else {
+        row.spans.push_back({s.t_s, t1, category});
+      }
+      any = true;
+    }
+    rows.push_back(std::move(row));
+  }
+  if (!any) return Status();  // nothing happened: no picture
+  Result<std::string> svg = SvgTimeline(rows, tp);
+  if (!svg.ok()) return svg.status().Naming(path);
+  return WriteFileAtomically(path, *svg);
+}
+
 // Top-down picture: the final floor map, paths, start and end marks, task views.
 Status WriteTopDown(const ExploreResult& r, const std::string& path) {
   TopDownRaster raster;
@@ -245,15 +278,19 @@ Status WriteRunOutputs(const ExploreRunParams& params, const ExploreRunReport& r
   if (Status s = WriteLines(r.plan_log, path); !s.ok()) return s.Naming(path);
   path = InFolder(params.out_dir, "plan_calls.csv");
   if (Status s = WriteLines(PlanCallRows(r.plan_calls), path); !s.ok()) return s.Naming(path);
+  path = InFolder(params.out_dir, "robot.json");
+  VOXPLAN_RETURN_IF_ERROR(WriteFileAtomically(path, RobotConfigJson(params.explore.robot)));
   path = InFolder(params.out_dir, "objects.csv");
   if (Status s = WriteLines(ObjectRows(report.objects), path); !s.ok()) return s.Naming(path);
+  VOXPLAN_RETURN_IF_ERROR(WriteTimeline(r, InFolder(params.out_dir, "timeline.svg")));
   return WriteTopDown(r, InFolder(params.out_dir, "topdown.png"));
 }
 
 std::vector<std::string> RunOutputFiles(const std::string& out_dir) {
   std::vector<std::string> paths;
-  for (const char* name : {"mesh.ply", "metrics.json", "run_log.csv", "timeseries.csv",
-                           "plan_log.txt", "plan_calls.csv", "objects.csv", "topdown.png"})
+  for (const char* name :
+       {"mesh.ply", "metrics.json", "run_log.csv", "timeseries.csv", "plan_log.txt",
+        "plan_calls.csv", "objects.csv", "robot.json", "timeline.svg", "topdown.png"})
     paths.push_back(InFolder(out_dir, name));
   return paths;
 }

@@ -7,9 +7,11 @@
 //                   crashed or hung in); all but plan_ms_* and the fault's times repeat for a seed
 //   timeseries.csv  coverage, completeness (every 30 s, volume estimate), distance vs time
 //   run_log.csv     every robot's poses and status (eval/eval_run.h format)
+//   timeline.svg    per robot: its mode (explorer, reconstructor) or idle over time
 //   topdown.png     the final floor map, each robot's path, start / end marks, reached views
 //   plan_log.txt    rejected tasks, failed tasks and plans, the plugin's messages
 //   plan_calls.csv  one row per plan call with its wall time and the plugin's diagnostics
+//   robot.json      the robot and its modes as run (explore/robot_config.h: --robot-config)
 //   objects.csv     per object: completeness at 2 and 5 cm, accuracy (Guo 2022 eq. 6, 7)
 // Every error names the file it could not write. The report as JSON is here too, beside
 // metrics.json.

@@ -159,4 +159,68 @@ Result<std::string> SvgLinePlot(const std::vector<PlotSeries>& series, const Plo
   return svg;
 }
 
+Result<std::string> SvgTimeline(const std::vector<TimelineRow>& rows,
+                                const TimelineParams& params) {
+  double t_lo = std::numeric_limits<double>::infinity(), t_hi = -t_lo;
+  for (const TimelineRow& row : rows)
+    for (const TimelineSpan& s : row.spans) {
+      if (!std::isfinite(s.t0_s) || !std::isfinite(s.t1_s) || s.t1_s < s.t0_s)
+        return InvalidArgument("timeline row '" + row.name + "' has a span with bad times");
+      if (s.category < 0 || size_t(s.category) >= params.categories.size())
+        return InvalidArgument("timeline row '" + row.name + "' has a span of unknown category " +
+                               std::to_string(s.category));
+      t_lo = std::min(t_lo, s.t0_s), t_hi = std::max(t_hi, s.t1_s);
+    }
+  if (!(t_lo <= t_hi)) return InvalidArgument("timeline '" + params.title + "' has no span");
+  if (t_hi == t_lo) t_hi = t_lo + 1.0;
+  const std::vector<double> ticks = NiceTicks(t_lo, t_hi, 6);
+  t_lo = std::min(t_lo, ticks.front()), t_hi = std::max(t_hi, ticks.back());
+
+  const double w = params.width_px, row_h = params.row_px;
+  const double left = 60, right = w - 150, top = 40;
+  const double bottom = top + row_h * double(std::max<size_t>(rows.size(), 1));
+  const double h = bottom + 50;
+  auto px = [&](double t) { return left + (t - t_lo) / (t_hi - t_lo) * (right - left); };
+  std::string svg = "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"" + Fmt(w, 0) +
+                    "\" height=\"" + Fmt(h, 0) + "\" viewBox=\"0 0 " + Fmt(w, 0) + " " + Fmt(h, 0) +
+                    "\" font-family=\"sans-serif\" font-size=\"12\">\n";
+  svg += "<rect width=\"100%\" height=\"100%\" fill=\"white\"/>\n";
+  svg += "<text x=\"" + Fmt(w / 2, 1) + "\" y=\"22\" text-anchor=\"middle\" font-size=\"15\">" +
+         Escape(params.title) + "</text>\n";
+  const int dec = TickDecimals(ticks);
+  for (double t : ticks) {
+    const std::string x = Fmt(px(t), 1);
+    svg += "<line x1=\"" + x + "\" y1=\"" + Fmt(top, 1) + "\" x2=\"" + x + "\" y2=\"" +
+           Fmt(bottom, 1) + "\" stroke=\"#e0e0e0\"/>\n";
+    svg += "<text x=\"" + x + "\" y=\"" + Fmt(bottom + 16, 1) + "\" text-anchor=\"middle\">" +
+           Fmt(t, dec) + "</text>\n";
+  }
+  for (size_t k = 0; k < rows.size(); ++k) {
+    const double y = top + row_h * double(k);
+    svg += "<text x=\"" + Fmt(left - 6, 1) + "\" y=\"" + Fmt(y + row_h / 2, 1) +
+           "\" text-anchor=\"end\" dominant-baseline=\"middle\">" + Escape(rows[k].name) +
+           "</text>\n";
+    for (const TimelineSpan& s : rows[k].spans) {
+      if (s.t1_s <= s.t0_s) continue;
+      svg += "<rect x=\"" + Fmt(px(s.t0_s)) + "\" y=\"" + Fmt(y + 3, 1) + "\" width=\"" +
+             Fmt(px(s.t1_s) - px(s.t0_s)) + "\" height=\"" + Fmt(row_h - 6, 1) + "\" fill=\"" +
+             Hex(params.categories[size_t(s.category)].rgbx) + "\"/>\n";
+    }
+  }
+  svg += "<rect x=\"" + Fmt(left, 1) + "\" y=\"" + Fmt(top, 1) + "\" width=\"" +
+         Fmt(right - left, 1) + "\" height=\"" + Fmt(bottom - top, 1) +
+         "\" fill=\"none\" stroke=\"#404040\"/>\n";
+  svg += "<text x=\"" + Fmt((left + right) / 2, 1) + "\" y=\"" + Fmt(h - 12, 1) +
+         "\" text-anchor=\"middle\">" + Escape(params.x_label) + "</text>\n";
+  for (size_t k = 0; k < params.categories.size(); ++k) {
+    const double ly = top + 10 + 20 * double(k);
+    svg += "<rect x=\"" + Fmt(right + 12, 1) + "\" y=\"" + Fmt(ly - 6, 1) +
+           "\" width=\"24\" height=\"12\" fill=\"" + Hex(params.categories[k].rgbx) + "\"/>\n";
+    svg += "<text x=\"" + Fmt(right + 42, 1) + "\" y=\"" + Fmt(ly, 1) +
+           "\" dominant-baseline=\"middle\">" + Escape(params.categories[k].name) + "</text>\n";
+  }
+  svg += "</svg>\n";
+  return svg;
+}
+
 }  // namespace voxplan

@@ -16,6 +16,7 @@
 #include "core/bounds.h"
 #include "core/parallel.h"
 #include "explore/explore_run.h"
+#include "explore/robot_config.h"
 #include "explore/run_outputs.h"
 #include "io/file_util.h"
 
@@ -56,7 +57,10 @@ struct ExploreOptions {
   bool no_color = false;
   bool no_clear = false;
   double fuse_step_m = 0.25, fuse_step_deg = 15.0;
-  double capture_hz = 0.0;  // both modes; 0: the displacement trigger
+  double capture_hz = 0.0;        // both modes; 0: the displacement trigger
+  std::string profile;            // ApplyExploreProfile; "" none
+  std::string robot_config;       // over the profile's robot
+  const CLI::App* app = nullptr;  // which options were given (they override profile and file)
   int threads = 0;
   MemoryBudgetOptions memory;
   PlannerLimits limits;  // --planner-hard-limit, --planner-hard-limit-min
@@ -161,14 +165,26 @@ int LoadPlannerOption(const ExploreOptions& o, std::unique_ptr<LoadedPlanner>* o
   return kExitOk;
 }
 
-// The experiment the options ask for.
-ExploreRunParams RunParams(const ExploreOptions& o, std::vector<Eigen::Vector2f> starts) {
+// Whether the user gave an option (so it overrides the profile's and the robot file's value).
+bool Given(const ExploreOptions& o, const char* name) {
+  return o.app != nullptr && o.app->count(name) > 0;
+}
+
+// The experiment the options ask for; a bad profile or robot file is refused (usage).
+Result<ExploreRunParams> RunParams(const ExploreOptions& o, std::vector<Eigen::Vector2f> starts) {
   ExploreRunParams run = o.run;
   run.scene_load = SceneLoad(o.frame);
   run.starts = std::move(starts);
   ExploreParams& params = run.explore;
+  if (!o.profile.empty()) VOXPLAN_RETURN_IF_ERROR(ApplyExploreProfile(o.profile, &params));
+  if (!o.robot_config.empty()) {
+    Result<RobotParams> robot = ReadRobotConfig(o.robot_config, params.robot);
+    if (!robot.ok()) return robot.status();
+    params.robot = *robot;
+  }
   params.voxel_size_m = float(o.voxel_size);
-  params.recon_voxel_size_m = float(o.recon_voxel_size);
+  if (o.profile.empty() || Given(o, "--recon-voxel-size"))
+    params.recon_voxel_size_m = float(o.recon_voxel_size);
   params.max_memory_bytes = MemoryBudgetBytes(o.memory);
   params.noise = !o.no_noise;
   params.fuse_labels = !o.no_labels;
@@ -176,9 +192,13 @@ ExploreRunParams RunParams(const ExploreOptions& o, std::vector<Eigen::Vector2f>
   params.fuse_color = !o.no_color;
   params.clear_beyond_range = !o.no_clear;
   params.trigger = {float(o.fuse_step_m), float(o.fuse_step_deg)};
-  params.robot.explorer.horizontal_fov_deg = float(o.fov_deg);
-  params.robot.explorer.max_range_m = float(o.max_range_m);
-  params.robot.explorer.capture_hz = params.robot.reconstructor.capture_hz = float(o.capture_hz);
+  // The camera options: always without a profile or robot file (their defaults are the
+  // robot's), else only when given.
+  const bool plain = o.profile.empty() && o.robot_config.empty();
+  if (plain || Given(o, "--fov-deg")) params.robot.explorer.horizontal_fov_deg = float(o.fov_deg);
+  if (plain || Given(o, "--max-range-m")) params.robot.explorer.max_range_m = float(o.max_range_m);
+  if (plain || Given(o, "--capture-hz"))
+    params.robot.explorer.capture_hz = params.robot.reconstructor.capture_hz = float(o.capture_hz);
   return run;
 }
 
@@ -190,7 +210,8 @@ int RunExploreCommand(const ExploreOptions& o) {
   const bool planner_file = o.planner.find('/') != std::string::npos;
   if (int code = RefusePathCollisions(outputs, {{"--scene", o.run.scene},
                                                 {"--planner", planner_file ? o.planner : ""},
-                                                {"--planner-config", o.planner_config}});
+                                                {"--planner-config", o.planner_config},
+                                                {"--robot-config", o.robot_config}});
       code != kExitOk)
     return code;
   std::unique_ptr<LoadedPlanner> planner;
@@ -210,7 +231,9 @@ int RunExploreCommand(const ExploreOptions& o) {
               << RoundTo(p.distance_total_m, 1) << " m, " << p.plan_calls << " plan calls"
               << std::endl;
   };
-  const ExploreRunParams run = RunParams(o, std::move(starts));
+  Result<ExploreRunParams> asked = RunParams(o, std::move(starts));
+  if (!asked.ok()) return Fail(asked.status().message(), kExitUsage);
+  const ExploreRunParams& run = *asked;
   bool refused = false;
   OutputTransaction transaction;  // every file lands, or none (and no folder it made)
   transaction.WatchFolder(run.out_dir);
@@ -261,6 +284,16 @@ Command AddExploreCommand(CLI::App& app) {
   sub->add_option("--planner", o->planner, "Planner name (libvoxplan_planner_<name>.so) or path")
       ->required();
   sub->add_option("--planner-config", o->planner_config, "JSON file handed to the planner");
+  sub->add_option("--profile", o->profile,
+                  std::string("Simulator settings of a paper's experiments (") +
+                      ExploreProfileNames() +
+                      "): guo2022 = Guo 2022's robot (head explorer, arm reconstructor, 2 Hz "
+                      "capture, 2 s mode switch; explore/robot_config.h), a 2 cm reconstruction "
+                      "volume, detector noise on. Options given beside it win");
+  sub->add_option("--robot-config", o->robot_config,
+                  "JSON file of the robot and both modes (speeds, fields of view, ranges, "
+                  "mounts, capture, switch time; explore/robot_config.h), over --profile's; "
+                  "every run writes the robot it used to robot.json in --out");
   sub->add_option("--seed", run.explore.seed, "Seed of the planner and the sensor noise")
       ->capture_default_str();
   sub->add_option("--max-time", run.explore.max_time_s, "Simulated seconds before the run stops")
@@ -323,6 +356,7 @@ Command AddExploreCommand(CLI::App& app) {
            "Simulated seconds between progress lines on stderr");
   sub->add_option("--threads", o->threads, "Worker threads (0: all)")->check(ThreadCount());
   AddMemoryBudgetOptions(sub, o->memory, /*with_on_limit=*/false);
+  o->app = sub;
   return {sub, [o] { return RunExploreCommand(*o); }};
 }
 

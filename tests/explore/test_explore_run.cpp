@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "explore/explore_run.h"
+#include "explore/robot_config.h"
 #include "explore/run_outputs.h"
 #include "tests/support/test_support.h"
 
@@ -131,6 +132,14 @@ TEST(ExploreRun, ShortRunWritesEveryArtefactAndItsMetricsAgree) {
   EXPECT_EQ(objects[0].rfind("id,class,model,", 0), 0u);
   for (const ObjectEvalResult& o : report->objects->objects)
     EXPECT_NE(o.class_name, "wall");  // structure is not an object
+
+  // The robot as run, and a timeline of the explorer mode (greedy's only) per robot.
+  Result<RobotParams> robot = ReadRobotConfig((dir / "out" / "robot.json").string(), {});
+  ASSERT_TRUE(robot.ok()) << robot.status().message();
+  EXPECT_EQ(RobotConfigJson(*robot), RobotConfigJson(params.explore.robot));
+  const std::vector<std::string> svg = Lines(dir / "out" / "timeline.svg");
+  ASSERT_FALSE(svg.empty());
+  EXPECT_EQ(svg[0].rfind("<svg", 0), 0u);
 
   // The tables: a header and one row per plan call; every robot's poses in the run log.
   EXPECT_EQ(Lines(dir / "out" / "plan_calls.csv").size(), loop.plan_calls.size() + 1);

@@ -132,3 +132,28 @@ TEST(SvgPlot, RefusesMismatchedOrEmptySeries) {
 
 }  // namespace
 }  // namespace voxplan
+
+namespace voxplan {
+namespace {
+
+TEST(SvgTimeline, DrawsOneRectanglePerSpanInItsCategorysColourAndRefusesBadSpans) {
+  TimelineParams tp;
+  tp.title = "modes";
+  tp.categories = {{"explorer", PackRgb(255, 0, 0)}, {"idle", PackRgb(0, 0, 255)}};
+  const std::vector<TimelineRow> rows = {{"r0", {{0.0, 10.0, 0}, {10.0, 15.0, 1}}},
+                                         {"r1", {{0.0, 15.0, 0}}}};
+  Result<std::string> svg = SvgTimeline(rows, tp);
+  ASSERT_TRUE(svg.ok()) << svg.status().message();
+  size_t red = 0, blue = 0;
+  for (size_t at = 0; (at = svg->find("fill=\"#ff0000\"", at)) != std::string::npos; ++at) ++red;
+  for (size_t at = 0; (at = svg->find("fill=\"#0000ff\"", at)) != std::string::npos; ++at) ++blue;
+  EXPECT_EQ(red, 3u);                       // two spans and the legend
+  EXPECT_EQ(blue, 2u);                      // one span and the legend
+  EXPECT_EQ(*SvgTimeline(rows, tp), *svg);  // same input, same bytes
+  EXPECT_FALSE(SvgTimeline({{"r0", {{0.0, 1.0, 2}}}}, tp).ok());
+  EXPECT_FALSE(SvgTimeline({{"r0", {{2.0, 1.0, 0}}}}, tp).ok());
+  EXPECT_FALSE(SvgTimeline({{"r0", {}}}, tp).ok());
+}
+
+}  // namespace
+}  // namespace voxplan
