@@ -92,8 +92,6 @@ class FloorView {
   vp_floor f_;
 };
 
-// Read-only view of the maps for one plan() call. Spans point at host memory that stays valid
-// until Plan returns; copy what must outlive it.
 // A vp_task_ext that changes nothing: the mount's rest pose, no look-at, no sweep, no object.
 inline vp_task_ext DefaultTaskExt() {
   vp_task_ext e{};
@@ -104,6 +102,8 @@ inline vp_task_ext DefaultTaskExt() {
   return e;
 }
 
+// Read-only view of the maps for one plan() call. Spans point at host memory that stays valid
+// until Plan returns; copy what must outlive it.
 class WorldView {
  public:
   WorldView(const vp_host_api* host, const vp_world* world) : host_(host), world_(world) {
