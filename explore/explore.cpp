@@ -196,7 +196,10 @@ Status Explorer::Fuse(RobotRun& r, bool force) {
   if (!stats.ok()) return stats.status();
   result_.blocks_dropped += stats->integrate.blocks_refused;
   if (recon_) {  // the same frame into the finer volume, for the mesh alone
-    Result<IntegrateStats> fine = IntegrateFrame(out.depth, out.color, camera, T_W_C, ip, *recon_);
+    IntegrateParams fine_ip = ip;
+    fine_ip.weighting = p_.recon_weighting;
+    Result<IntegrateStats> fine =
+        IntegrateFrame(out.depth, out.color, camera, T_W_C, fine_ip, *recon_);
     if (!fine.ok()) return fine.status();
     result_.blocks_dropped += fine->blocks_refused;
   }

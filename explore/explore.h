@@ -37,6 +37,7 @@
 #include "core/status.h"
 #include "core/volume.h"
 #include "eval/eval_run.h"
+#include "fusion/integrate.h"
 #include "planning/floor_map.h"
 #include "planning/planning_map.h"
 #include "plugins/host/plugin_host.h"
@@ -56,6 +57,9 @@ struct ExploreParams {
   // > 0: a second, finer TSDF (e.g. 0.02 m, trunc_vox voxels) fused with the same frames, for
   // the final mesh and its metrics; the planners keep voxel_size_m. Its own max_memory_bytes.
   float recon_voxel_size_m = 0.f;
+  // How the reconstruction volume weighs a frame's depth: 1/z² (Voxblox's default, which Guo 2022
+  // fused with) lets a close scan outweigh far, noisier ones; the planning map stays constant.
+  Weighting recon_weighting = Weighting::kConstant;
   bool noise = true;        // Kinect noise on the rendered depth
   bool fuse_labels = true;  // instance labels into the object map
   // How the labels are detected before they are fused (sim/detector.h): noisy by default.

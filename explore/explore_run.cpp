@@ -105,8 +105,16 @@ Status Evaluate(const ExploreRunParams& params, const World& world, const FloorP
                 const PointSetFilter& filter, ExploreRunReport& report) {
   const Stopwatch eval_clock;
   // The finer reconstruction volume when the run kept one, else the planning map.
+  // Depth-weighted, one observation at the farthest range weighs 1 / range²: it still counts as
+  // observed, as one observation does at constant weight (MeshParams::min_weight 0.5).
+  MeshParams mp;
+  if (report.loop.recon_volume && params.explore.recon_weighting == Weighting::kDepthDependent) {
+    const RobotParams& robot = params.explore.robot;
+    const float range = std::max(robot.explorer.max_range_m, robot.reconstructor.max_range_m);
+    mp.min_weight = 0.5f / (range * range);
+  }
   report.mesh =
-      ExtractMesh(report.loop.recon_volume ? *report.loop.recon_volume : *report.loop.volume);
+      ExtractMesh(report.loop.recon_volume ? *report.loop.recon_volume : *report.loop.volume, mp);
   VOXPLAN_RETURN_IF_ERROR(WriteRunMesh(report.mesh, params.out_dir));
   MeshEvalParams ep;
   ep.threshold_m = 0.05f;

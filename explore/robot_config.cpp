@@ -194,6 +194,7 @@ Status ApplyExploreProfile(const std::string& name, ExploreParams* params) {
   if (name == "guo2022") {
     params->robot = Guo2022RobotParams();
     params->recon_voxel_size_m = 0.02f;
+    params->recon_weighting = Weighting::kDepthDependent;
     params->detector = DetectorParams{};
     return Status::Ok();
   }

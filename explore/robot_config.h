@@ -41,7 +41,8 @@ Result<RobotParams> ReadRobotConfig(const std::string& path, const RobotParams& 
 std::string RobotConfigJson(const RobotParams& params);
 
 // A profile's simulator settings over `params` (robot, capture, reconstruction volume, detector):
-//   "guo2022": Guo2022RobotParams(), a 2 cm reconstruction volume, the detector's noise on.
+//   "guo2022": Guo2022RobotParams(), a 2 cm reconstruction volume weighing depth by 1/z² (as
+//              Voxblox, Guo's fusion, does), the detector's noise on.
 // NotFound for an unknown name.
 Status ApplyExploreProfile(const std::string& name, ExploreParams* params);
 // The profile names, for usage text.

@@ -196,11 +196,14 @@ std::vector<Candidate> TaskGenerator::Reconstruction(const vp::WorldView& world,
   const ReconViewParams params =
       ViewParamsOf(world.Mode(0, VP_MODE_RECONSTRUCTOR), world.Robot(0), options_.views);
   std::vector<Candidate> out;
-  const size_t served =
-      std::min(incomplete.size(), size_t(std::max(0, options_.max_objects_per_round)));
-  for (size_t k = 0; k < served; ++k) {
-    const int id = incomplete[k].second;
-    const ObjectState& object = objects_.at(id);
+  const size_t want = size_t(std::max(0, options_.recon_views_per_robot)) * robots;
+  int tried = 0;
+  for (const auto& [incompleteness, id] : incomplete) {
+    if (out.size() >= want || tried >= options_.max_objects_per_round) break;
+    ObjectState& object = objects_.at(id);
+    if (object.no_views_at == object.voxels || object.rounds >= options_.max_rounds_per_object)
+      continue;
+    ++tried;
     const ReconTarget target = TargetFromCompletion(id, floor_z, object.completion);
     const std::vector<ReconView> views = SelectReconViews(
         target, params, traversable, visible, FindHistory(history_, id), options_.history);
@@ -209,6 +212,7 @@ std::vector<Candidate> TaskGenerator::Reconstruction(const vp::WorldView& world,
     for (const ReconView& v : views)
       cameras.insert(cameras.end(), {v.camera_m.x(), v.camera_m.y(), v.camera_m.z()});
     const std::vector<uint8_t> states = world.VoxelStates(cameras);
+    const size_t before = out.size();
     for (size_t i = 0; i < views.size(); ++i) {
       if (states[i] != VP_VOXEL_FREE) continue;
       const ReconView& v = views[i];
@@ -219,6 +223,7 @@ std::vector<Candidate> TaskGenerator::Reconstruction(const vp::WorldView& world,
       c.recon = v;
       out.push_back(std::move(c));
     }
+    if (out.size() == before) object.no_views_at = object.voxels;
   }
   stats->reconstruction_views = int(out.size());
   stats->recon_ms = (world.ElapsedS() - t0) * 1e3;
@@ -236,6 +241,7 @@ void TaskGenerator::Sent(const std::vector<Candidate>& sent) {
 void TaskGenerator::SentViews(int object_id, const std::vector<ReconView>& views) {
   const auto it = objects_.find(object_id);
   const double completeness = it == objects_.end() ? 0.0 : double(it->second.voxels);
+  if (it != objects_.end()) ++it->second.rounds;
   RecordViews(&history_, object_id, views, completeness);
 }
 

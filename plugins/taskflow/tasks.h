@@ -23,11 +23,21 @@ struct TaskOptions {
   ExploreParams explore;
   CompletionParams completion;
   ReconViewParams views;
-  HistoryParams history;
-  bool completion_on = true;          // "completion": "none" gives frontier tasks only
-  double clearance_margin_m = 0.05;   // beyond the robot radius, as the host routes
-  int min_object_voxels = 20;         // smaller instances are detector noise, not objects
-  int max_objects_per_round = 3;      // incomplete objects served per round, most incomplete first
+  // A round gains when the object's observed surface grows by 5 %: fewer new voxels are what
+  // depth noise adds to any surface seen again.
+  HistoryParams history = {
+      .neighbourhood_m = 0.5f, .strikes = 3, .min_gain_abs = 0.0, .min_gain_rel = 0.05};
+  bool completion_on = true;         // "completion": "none" gives frontier tasks only
+  double clearance_margin_m = 0.05;  // beyond the robot radius, as the host routes
+  int min_object_voxels = 20;        // smaller instances are detector noise, not objects
+  // Incomplete objects are served most incomplete first until the round holds this many views
+  // per robot, trying at most max_objects_per_round of them.
+  int recon_views_per_robot = 2;
+  int max_objects_per_round = 12;
+  // Rounds of views an object gets at most. The paper's history (three no-gain scans close a
+  // neighbourhood) never closes an object whose hidden side faces a wall: the completion keeps
+  // predicting it and every new neighbourhood looks worth a try.
+  int max_rounds_per_object = 4;
   int frontier_tries = 2;             // a frontier covered this often and still there is settled
   float frontier_key_m = 0.25f;       // frontier memory cell
   float view_dwell_s = 0.5f;          // explorer: at the view, before the sweep
@@ -40,7 +50,10 @@ struct TaskOptions {
 struct ObjectState {
   size_t voxels = 0;
   CompletionResult completion;
-  int rounds_served = 0;
+  // The surface size at which view selection last found nothing (a hidden side against a wall):
+  // not tried again until the object's surface changes.
+  size_t no_views_at = 0;
+  int rounds = 0;  // rounds it was given views in
 };
 
 // A generated task before assignment.

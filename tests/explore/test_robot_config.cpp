@@ -59,6 +59,7 @@ TEST(RobotConfig, TheGuoProfileSetsTheRobotTheFineVolumeAndTheDetector) {
   params.detector.noise = false;
   ASSERT_TRUE(ApplyExploreProfile("guo2022", &params).ok());
   EXPECT_EQ(params.recon_voxel_size_m, 0.02f);
+  EXPECT_EQ(params.recon_weighting, Weighting::kDepthDependent);
   EXPECT_TRUE(params.detector.noise);
   EXPECT_EQ(params.robot.reconstructor.mount, MountKind::kArm);
   EXPECT_EQ(params.robot.explorer.capture_hz, 2.f);
