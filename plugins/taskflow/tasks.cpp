@@ -136,7 +136,9 @@ std::vector<Candidate> TaskGenerator::Reconstruction(const vp::WorldView& world,
     const int id = int(instance.id);
     ObjectState& object = objects_[id];
     ObserveCompleteness(&history_, id, double(surface.size()), options_.history);
-    if (object.voxels != surface.size()) {  // its surface changed: complete it again
+    const double change = std::abs(double(surface.size()) - double(object.voxels)) /
+                          std::max(1.0, double(object.voxels));
+    if (object.voxels == 0 || change >= options_.recomplete_share) {  // complete it again
       std::vector<Eigen::Vector3f> points, normals;
       for (const vp_surface_voxel& v : surface) {
         points.emplace_back(v.position[0], v.position[1], v.position[2]);
@@ -203,6 +205,8 @@ std::vector<Candidate> TaskGenerator::Reconstruction(const vp::WorldView& world,
     ObjectState& object = objects_.at(id);
     if (object.no_views_at == object.voxels || object.rounds >= options_.max_rounds_per_object)
       continue;
+    const double gained = double(object.voxels) / std::max(1.0, double(object.voxels_sent)) - 1.0;
+    if (object.rounds > 0 && gained < options_.history.min_gain_rel) continue;
     ++tried;
     const ReconTarget target = TargetFromCompletion(id, floor_z, object.completion);
     const std::vector<ReconView> views = SelectReconViews(
@@ -241,7 +245,10 @@ void TaskGenerator::Sent(const std::vector<Candidate>& sent) {
 void TaskGenerator::SentViews(int object_id, const std::vector<ReconView>& views) {
   const auto it = objects_.find(object_id);
   const double completeness = it == objects_.end() ? 0.0 : double(it->second.voxels);
-  if (it != objects_.end()) ++it->second.rounds;
+  if (it != objects_.end()) {
+    ++it->second.rounds;
+    it->second.voxels_sent = it->second.voxels;
+  }
   RecordViews(&history_, object_id, views, completeness);
 }
 

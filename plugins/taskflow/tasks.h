@@ -22,7 +22,13 @@ namespace voxplan::taskflow {
 struct TaskOptions {
   ExploreParams explore;
   CompletionParams completion;
-  ReconViewParams views;
+  // A view must cover a tenth of the object's initial incompleteness (the library's 5 % sends
+  // views that add a handful of points, at a reconstructor's 0.2 m/s).
+  ReconViewParams views = [] {
+    ReconViewParams p;
+    p.min_gain_fraction = 0.1f;
+    return p;
+  }();
   // A round gains when the object's observed surface grows by 5 %: fewer new voxels are what
   // depth noise adds to any surface seen again.
   HistoryParams history = {
@@ -34,10 +40,15 @@ struct TaskOptions {
   // per robot, trying at most max_objects_per_round of them.
   int recon_views_per_robot = 2;
   int max_objects_per_round = 12;
-  // Rounds of views an object gets at most. The paper's history (three no-gain scans close a
-  // neighbourhood) never closes an object whose hidden side faces a wall: the completion keeps
-  // predicting it and every new neighbourhood looks worth a try.
-  int max_rounds_per_object = 4;
+  // Rounds of views an object gets at most; and none after a round that gained nothing (its
+  // surface grew by less than history.min_gain_rel since the views were sent). The paper's
+  // history (three no-gain scans close a neighbourhood) never closes an object whose hidden
+  // side faces a wall: the completion keeps predicting it, every new neighbourhood looks worth
+  // a try, and a run of 60 objects does not end.
+  int max_rounds_per_object = 2;
+  // The completion is recomputed when an object's surface grew (or shrank) by this share since
+  // it was last completed: every frame adds a voxel or two, and a completion costs ~30 ms.
+  double recomplete_share = 0.05;
   int frontier_tries = 2;             // a frontier covered this often and still there is settled
   float frontier_key_m = 0.25f;       // frontier memory cell
   float view_dwell_s = 0.5f;          // explorer: at the view, before the sweep
@@ -53,7 +64,8 @@ struct ObjectState {
   // The surface size at which view selection last found nothing (a hidden side against a wall):
   // not tried again until the object's surface changes.
   size_t no_views_at = 0;
-  int rounds = 0;  // rounds it was given views in
+  int rounds = 0;          // rounds it was given views in
+  size_t voxels_sent = 0;  // its surface when its last views were sent
 };
 
 // A generated task before assignment.
