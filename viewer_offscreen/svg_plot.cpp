@@ -52,6 +52,17 @@ int TickDecimals(const std::vector<double>& ticks) {
   return std::clamp(int(std::ceil(-std::log10(step) - 1e-9)), 0, 6);
 }
 
+// The document's opening: size, white background, the title centred on top.
+std::string SvgOpen(double w, double h, const std::string& title) {
+  std::string svg = "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"" + Fmt(w, 0) +
+                    "\" height=\"" + Fmt(h, 0) + "\" viewBox=\"0 0 " + Fmt(w, 0) + " " + Fmt(h, 0) +
+                    "\" font-family=\"sans-serif\" font-size=\"12\">\n";
+  svg += "<rect width=\"100%\" height=\"100%\" fill=\"white\"/>\n";
+  svg += "<text x=\"" + Fmt(w / 2, 1) + "\" y=\"22\" text-anchor=\"middle\" font-size=\"15\">" +
+         Escape(title) + "</text>\n";
+  return svg;
+}
+
 }  // namespace
 
 std::vector<double> NiceTicks(double lo, double hi, int count) {
@@ -98,12 +109,7 @@ Result<std::string> SvgLinePlot(const std::vector<PlotSeries>& series, const Plo
   auto px = [&](double x) { return left + (x - x_lo) / (x_hi - x_lo) * (right - left); };
   auto py = [&](double y) { return bottom - (y - y_lo) / (y_hi - y_lo) * (bottom - top); };
 
-  std::string svg = "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"" + Fmt(w, 0) +
-                    "\" height=\"" + Fmt(h, 0) + "\" viewBox=\"0 0 " + Fmt(w, 0) + " " + Fmt(h, 0) +
-                    "\" font-family=\"sans-serif\" font-size=\"12\">\n";
-  svg += "<rect width=\"100%\" height=\"100%\" fill=\"white\"/>\n";
-  svg += "<text x=\"" + Fmt(w / 2, 1) + "\" y=\"22\" text-anchor=\"middle\" font-size=\"15\">" +
-         Escape(params.title) + "</text>\n";
+  std::string svg = SvgOpen(w, h, params.title);
   const int x_dec = TickDecimals(x_ticks), y_dec = TickDecimals(y_ticks);
   for (double t : y_ticks) {
     const std::string y = Fmt(py(t), 1);
@@ -181,12 +187,7 @@ Result<std::string> SvgTimeline(const std::vector<TimelineRow>& rows,
   const double bottom = top + row_h * double(std::max<size_t>(rows.size(), 1));
   const double h = bottom + 50;
   auto px = [&](double t) { return left + (t - t_lo) / (t_hi - t_lo) * (right - left); };
-  std::string svg = "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"" + Fmt(w, 0) +
-                    "\" height=\"" + Fmt(h, 0) + "\" viewBox=\"0 0 " + Fmt(w, 0) + " " + Fmt(h, 0) +
-                    "\" font-family=\"sans-serif\" font-size=\"12\">\n";
-  svg += "<rect width=\"100%\" height=\"100%\" fill=\"white\"/>\n";
-  svg += "<text x=\"" + Fmt(w / 2, 1) + "\" y=\"22\" text-anchor=\"middle\" font-size=\"15\">" +
-         Escape(params.title) + "</text>\n";
+  std::string svg = SvgOpen(w, h, params.title);
   const int dec = TickDecimals(ticks);
   for (double t : ticks) {
     const std::string x = Fmt(px(t), 1);

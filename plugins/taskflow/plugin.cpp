@@ -136,7 +136,7 @@ class TaskflowPlanner : public vp::Planner {
     } else {
       Assign(world, team, candidates, out, &sequences, &modes);
     }
-    Emit(world, team, candidates, sequences, modes, out);
+    Emit(team, candidates, sequences, modes, out);
   }
 
  private:
@@ -185,10 +185,8 @@ class TaskflowPlanner : public vp::Planner {
     in.reconstructor_speed_mps = team.reconstructor[0].max_speed_mps;
     AssignmentParams params = options_.assignment;
     params.seed = world.seed();
-    // Annealing stops with a third of the call's budget left for the rest.
-    const double budget_s = world.call().time_budget_s;
-    if (budget_s > 0.0)
-      params.out_of_time = [&world, budget_s] { return world.ElapsedS() > 0.6 * budget_s; };
+    // No wall-clock deadline on the annealing: its iteration cap keeps it short (a few ms at 4
+    // robots), and a deadline would make the plan depend on the machine's speed.
     const AssignmentResult result = AssignTasks(in, params);
     if (!result.status.ok())
       throw vp::Error(VP_ERROR_PLUGIN, "taskflow: assignment: " + result.status.message);
@@ -250,7 +248,7 @@ class TaskflowPlanner : public vp::Planner {
     }
   }
 
-  void Emit(const vp::WorldView& world, const Team& team, const std::vector<Candidate>& candidates,
+  void Emit(const Team& team, const std::vector<Candidate>& candidates,
             const std::vector<std::vector<int>>& sequences, const std::vector<Mode>& modes,
             vp::PlanOutput& out) {
     std::vector<Candidate> sent;
@@ -307,7 +305,6 @@ class TaskflowPlanner : public vp::Planner {
     out.DebugPoints("taskflow_exploration", explore_xyz, kExploreColor);
     out.DebugPoints("taskflow_reconstruction", recon_xyz, kReconColor);
     out.Diagnostic("tasks_sent", double(sent.size()));
-    (void)world;
   }
 
   Options options_;
