@@ -2,6 +2,7 @@
 
 #include <Eigen/Eigenvalues>
 #include <algorithm>
+#include <bit>
 #include <cmath>
 #include <limits>
 #include <numeric>
@@ -411,22 +412,43 @@ std::vector<int> FarthestPointSample(std::span<const Eigen::Vector3f> points, in
     pool.resize(static_cast<std::size_t>(pool_limit));
     std::sort(pool.begin(), pool.end());
   }
+  // The pool's coordinates in three contiguous arrays, so the distance update vectorises; the sum
+  // runs in (p - c).squaredNorm()'s order, so the picks do not change. Distances are >= 0 (or
+  // +inf), whose bit patterns order as int32, so the running maximum is an integer one, kept per
+  // block of 64; the pick is the first point of the first block holding it (ties: lower index).
   const std::size_t m = pool.size();
+  std::vector<float> xs(m), ys(m), zs(m);
+  for (std::size_t i = 0; i < m; ++i) {
+    const Eigen::Vector3f& p = points[static_cast<std::size_t>(pool[i])];
+    xs[i] = p.x();
+    ys[i] = p.y();
+    zs[i] = p.z();
+  }
+  constexpr std::size_t kBlock = 64;
   std::vector<float> dist(m, kInf);
   std::size_t current = static_cast<std::size_t>(rng.Next() % m);
   out.reserve(static_cast<std::size_t>(count));
   for (int k = 0; k < count; ++k) {
     out.push_back(pool[current]);
-    const Eigen::Vector3f& c = points[static_cast<std::size_t>(pool[current])];
-    std::size_t next = 0;
-    float best = -1.0f;
-    for (std::size_t i = 0; i < m; ++i) {
-      dist[i] = std::min(dist[i], (points[static_cast<std::size_t>(pool[i])] - c).squaredNorm());
-      if (dist[i] > best) {
-        best = dist[i];
-        next = i;
+    const float cx = xs[current], cy = ys[current], cz = zs[current];
+    std::int32_t best = -1;
+    std::size_t best_block = 0;
+    for (std::size_t begin = 0; begin < m; begin += kBlock) {
+      const std::size_t end = std::min(m, begin + kBlock);
+      std::int32_t block_max = -1;
+      for (std::size_t i = begin; i < end; ++i) {
+        const float dx = xs[i] - cx, dy = ys[i] - cy, dz = zs[i] - cz;
+        const float d = std::min(dist[i], dx * dx + (dy * dy + dz * dz));
+        dist[i] = d;
+        block_max = std::max(block_max, std::bit_cast<std::int32_t>(d));
+      }
+      if (block_max > best) {
+        best = block_max;
+        best_block = begin;
       }
     }
+    std::size_t next = best_block;
+    while (std::bit_cast<std::int32_t>(dist[next]) != best) ++next;
     current = next;
   }
   std::sort(out.begin(), out.end());
