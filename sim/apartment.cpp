@@ -23,8 +23,9 @@ struct SizeClass {
 constexpr SizeClass kSizeClasses[] = {{"S", "s", 60.0f, 110.0f},
                                       {"M", "m", 110.0f, 200.0f},
                                       {"L", "l", 200.0f, 350.0f},
-                                      {"XL", "xl", 300.0f, 450.0f}};
-static_assert(std::size(kSizeClasses) == size_t(ApartmentSize::kXL) + 1);
+                                      {"XL", "xl", 300.0f, 450.0f},
+                                      {"R", "r", 20.0f, 70.0f}};
+static_assert(std::size(kSizeClasses) == size_t(ApartmentSize::kR) + 1);
 
 const SizeClass& ClassOf(ApartmentSize size) { return kSizeClasses[int(size)]; }
 
@@ -74,7 +75,7 @@ Result<ApartmentSize> ParseApartmentSize(const std::string& text) {
       return ApartmentSize(i);
     }
   }
-  return InvalidArgument("apartment size must be S, M, L or XL, got '" + text + "'");
+  return InvalidArgument("apartment size must be S, M, L, XL or R, got '" + text + "'");
 }
 
 const char* ApartmentSizeName(ApartmentSize size) { return ClassOf(size).name; }

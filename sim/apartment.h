@@ -40,7 +40,8 @@
 namespace voxplan {
 
 // Gross floor area 60-110, 110-200, 200-350, 300-450 m²; XL is Guo 2022's "large" (over 300).
-enum class ApartmentSize { kS, kM, kL, kXL };
+// R is a single furnished room of 20-70 m² (Xu 2017's scenes, X T1): no corridor, one room.
+enum class ApartmentSize { kS, kM, kL, kXL, kR };
 
 struct ApartmentParams {
   ApartmentSize size = ApartmentSize::kM;
@@ -54,7 +55,7 @@ struct ApartmentParams {
 
 Result<World> GenerateApartment(const ApartmentParams& params);
 
-// "S", "M", "L" (either case).
+// "S", "M", "L", "XL", "R" (either case).
 Result<ApartmentSize> ParseApartmentSize(const std::string& text);
 const char* ApartmentSizeName(ApartmentSize size);
 // Gross floor area range of a size class, m².

@@ -176,8 +176,10 @@ Command AddSimSceneCommand(CLI::App& sim) {
       "scene", "Generate an apartment or load a scene; write mesh, instances, rooms, floor plan");
   sub->add_option("--generate", o->generate, "What to generate: apartment");
   sub->add_option("--scene", o->scene, "Scene file to load (.ply .glb .obj .stl .dae)");
-  sub->add_option("--size", o->size,
-                  "Apartment size class: S (60-110 m²), M (110-200), L (200-350), XL (300-450)")
+  sub->add_option(
+         "--size", o->size,
+         "Apartment size class: S (60-110 m²), M (110-200), L (200-350), XL (300-450), R (one "
+         "room, 20-70)")
       ->capture_default_str();
   sub->add_option("--seed", o->seed, "Generator seed (same seed, same files)")
       ->capture_default_str();

@@ -381,9 +381,50 @@ void NameRooms(GridLayout* layout) {
         counts[room.type] > 1 ? room.type + "_" + std::to_string(++seen[room.type]) : room.type;
 }
 
+// A single room (size R, Xu 2017's scenes): four exterior walls around one furnished room of a
+// drawn type, the closed entrance in the west wall. Its own draws, after the outline's.
+GridLayout MakeRoomLayout(Rng& rng) {
+  GridLayout layout;
+  float lo_m2, hi_m2;
+  ApartmentAreaRange(ApartmentSize::kR, &lo_m2, &hi_m2);
+  const double margin_m2 = 0.05 * (hi_m2 - lo_m2);
+  const double area_m2 = rng.Uniform(lo_m2 + margin_m2, hi_m2 - margin_m2);
+  layout.height_u = 50 + rng.Int(0, 4);  // 2.50 .. 2.70 m
+  // Aspect 1:1 to 2:1, the depth (y) the short side.
+  const double depth_m = std::sqrt(area_m2 / rng.Uniform(1.0, 2.0));
+  layout.depth_u = Snap(depth_m);
+  layout.width_u = Snap(area_m2 / (layout.depth_u * kUnitM));
+  const int width_u = layout.width_u, depth_u = layout.depth_u;
+  AddWall(&layout, true, 0, width_u, 0, kExteriorWallU);                  // south
+  AddWall(&layout, true, 0, width_u, depth_u - kExteriorWallU, depth_u);  // north
+  const int west =
+      AddWall(&layout, false, kExteriorWallU, depth_u - kExteriorWallU, 0, kExteriorWallU);
+  AddWall(&layout, false, kExteriorWallU, depth_u - kExteriorWallU, width_u - kExteriorWallU,
+          width_u);  // east
+  static const char* const kTypes[] = {"living", "study", "bedroom", "dining"};
+  const int room =
+      AddRoom(&layout, kTypes[rng.Int(0, 3)],
+              {kExteriorWallU, kExteriorWallU, width_u - kExteriorWallU, depth_u - kExteriorWallU});
+  GridDoor door;
+  door.along_x = false;
+  const int door_width_u = 18;
+  const int interior_u = depth_u - 2 * kExteriorWallU;
+  door.o0 = kExteriorWallU + rng.Int(4, std::max(4, interior_u - 4 - door_width_u));
+  door.o1 = door.o0 + door_width_u;
+  door.t0 = 0;
+  door.t1 = kExteriorWallU;
+  door.closed = true;
+  door.room_a = room;
+  door.floor_room = room;
+  layout.walls[west].doors.push_back(AddDoor(&layout, door));
+  NameRooms(&layout);
+  return layout;
+}
+
 }  // namespace
 
 GridLayout MakeLayout(ApartmentSize size, Rng& rng) {
+  if (size == ApartmentSize::kR) return MakeRoomLayout(rng);
   GridLayout layout;
   const int corridor_width_u = DrawOutline(size, rng, &layout);
   const Bands bands = DrawBands(layout, corridor_width_u, rng);

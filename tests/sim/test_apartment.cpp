@@ -154,14 +154,19 @@ void CheckApartment(const World& w, ApartmentSize size, const std::string& what)
   }
   EXPECT_GT(rooms_m2, 0.75f * gross);
   EXPECT_EQ(names.size(), w.rooms.size());  // unique names
-  for (const char* must : {"living", "corridor", "kitchen"}) EXPECT_TRUE(names.count(must)) << must;
-  bool bedroom = false, bathroom = false;
-  for (const std::string& n : names) {
-    bedroom |= n.rfind("bedroom", 0) == 0;
-    bathroom |= n.rfind("bathroom", 0) == 0;
+  if (size == ApartmentSize::kR) {
+    EXPECT_EQ(w.rooms.size(), 1u);  // one room, no corridor
+  } else {
+    for (const char* must : {"living", "corridor", "kitchen"})
+      EXPECT_TRUE(names.count(must)) << must;
+    bool bedroom = false, bathroom = false;
+    for (const std::string& n : names) {
+      bedroom |= n.rfind("bedroom", 0) == 0;
+      bathroom |= n.rfind("bathroom", 0) == 0;
+    }
+    EXPECT_TRUE(bedroom);
+    EXPECT_TRUE(bathroom);
   }
-  EXPECT_TRUE(bedroom);
-  EXPECT_TRUE(bathroom);
 
   // Furniture: inside a room footprint, and its triangles' boxes clear of every wall box (wall
   // instances are single boxes).
@@ -261,6 +266,16 @@ TEST_P(ApartmentValidityXL, ClosedReachableClear) {
 
 INSTANTIATE_TEST_SUITE_P(Seeds, ApartmentValidityXL, ::testing::Range(0, 8));
 
+// Single rooms (size R, Xu 2017's scenes): the same guarantees with one room.
+class ApartmentValidityRoom : public ::testing::TestWithParam<int> {};
+
+TEST_P(ApartmentValidityRoom, ClosedReachableClear) {
+  const World w = Generate(ApartmentSize::kR, uint64_t(GetParam()));
+  CheckApartment(w, ApartmentSize::kR, "R seed " + std::to_string(GetParam()));
+}
+
+INSTANTIATE_TEST_SUITE_P(Seeds, ApartmentValidityRoom, ::testing::Range(0, 8));
+
 TEST(Apartment, ParametricOnlyWithoutIndex) {
   const World w = Generate(ApartmentSize::kS, 11, /*meshes=*/false);
   CheckApartment(w, ApartmentSize::kS, "parametric S seed 11");
@@ -328,6 +343,7 @@ TEST(Apartment, WrittenWorldLoadsBack) {
 TEST(Apartment, RefusesBadInput) {
   EXPECT_FALSE(ParseApartmentSize("XXL").ok());
   EXPECT_EQ(*ParseApartmentSize("xl"), ApartmentSize::kXL);
+  EXPECT_EQ(*ParseApartmentSize("R"), ApartmentSize::kR);
   EXPECT_TRUE(ParseApartmentSize("m").ok());
   ApartmentParams p;
   p.furniture_index = "/nonexistent/aws_furniture_index.tsv";
