@@ -46,8 +46,12 @@ std::string Fmt(double v, int decimals = 2) {
 struct QueuedTask {
   PlannerTask task;
   std::vector<Eigen::Vector2f> path;  // the plugin's dense path to it; empty: route on the map
-  bool dwelt = false;                 // at the view: the dwell's frames are taken
-  int sweep_steps_done = 0;           // then the pitch sweep's (TaskCamera)
+  // vp.motion: the path is driven without stopping (a path-only task: no final turn or dwell),
+  // each point at its speed (parallel to path; empty: the mode's speed).
+  bool continuous = false;
+  std::vector<float> speeds_mps = {};
+  bool dwelt = false;        // at the view: the dwell's frames are taken
+  int sweep_steps_done = 0;  // then the pitch sweep's (TaskCamera)
 };
 
 struct RobotRun {
@@ -59,6 +63,7 @@ struct RobotRun {
   std::deque<QueuedTask> queue;
   bool routed = false;                // the front task's route is set
   std::deque<Eigen::Vector2f> route;  // waypoints left to the front task
+  std::deque<float> route_speed_mps;  // a continuous task's speed per waypoint (else empty)
   std::vector<CameraSample> camera_trajectory;
   double trajectory_t0_s = 0.0;
   double t_s = 0.0;  // this robot's time on the run clock (its Robot clock plus waiting)
@@ -113,6 +118,9 @@ class Explorer {
   bool RouteTo(RobotRun& r, const QueuedTask& q);
   void Fail(RobotRun& r, const std::string& why);
   void Bump(RobotRun& r, const Eigen::Vector2f& goal_W);
+  // A drive the true floor refused on the way to q: a plugin path is left for the host's route,
+  // the host's own route bumps and fails the task.
+  void Blocked(RobotRun& r, QueuedTask& q, const Eigen::Vector2f& goal_W, const Status& why);
   Status UpdateFloor();
   std::vector<PlannerRobot> Snapshot() const;
   void CallPlanner(PlanEvent event, int32_t event_robot, const PlannerTask& failed);
@@ -144,7 +152,19 @@ class Explorer {
   uint32_t call_index_ = 0;
   int empty_calls_ = 0;  // consecutive calls that left every robot idle without a task
   bool done_ = false;
+  double wakeup_t_s_ = std::numeric_limits<double>::quiet_NaN();  // vp.schedule's request
 };
+
+// The waypoints left to a robot's front task.
+void ClearRoute(RobotRun& r) {
+  r.route.clear();
+  r.route_speed_mps.clear();
+}
+
+void PopWaypoint(RobotRun& r) {
+  r.route.pop_front();
+  if (!r.route_speed_mps.empty()) r.route_speed_mps.pop_front();
+}
 
 Status Explorer::Fuse(RobotRun& r, bool force) {
   const Pose3f T_W_C = r.robot.T_W_C();
@@ -264,7 +284,7 @@ void Explorer::Fail(RobotRun& r, const std::string& why) {
   ++result_.failed_tasks;
   r.queue.pop_front();
   r.routed = false;
-  r.route.clear();
+  ClearRoute(r);
 }
 
 // The bumper: what a refused drive on the host's route ran into goes on the floor map as
@@ -318,10 +338,14 @@ std::vector<Eigen::Vector2f> Shortcut(const std::vector<Eigen::Vector2f>& path,
 bool Explorer::RouteTo(RobotRun& r, const QueuedTask& q) {
   const Eigen::Vector2f from = r.robot.state().position_W;
   const Eigen::Vector2f to = q.task.position_m;
-  r.route.clear();
+  ClearRoute(r);
   if (!q.path.empty()) {
     r.route.assign(q.path.begin(), q.path.end());
-    if ((r.route.back() - to).norm() > 1e-4f) r.route.push_back(to);
+    r.route_speed_mps.assign(q.speeds_mps.begin(), q.speeds_mps.end());
+    if ((r.route.back() - to).norm() > 1e-4f) {
+      r.route.push_back(to);
+      if (!r.route_speed_mps.empty()) r.route_speed_mps.push_back(r.route_speed_mps.back());
+    }
     return true;
   }
   explore_world_.Refresh();
@@ -444,7 +468,7 @@ Status Explorer::StepToView(RobotRun& r, QueuedTask& q) {
   if (q.task.tag != kPathOnlyTag) r.views.push_back(q.task);
   r.queue.pop_front();
   r.routed = false;
-  r.route.clear();
+  ClearRoute(r);
   return Status::Ok();
 }
 
@@ -481,6 +505,11 @@ Status Explorer::Advance(RobotRun& r, double t_end_s) {
       r.routed = true;
     }
     if (r.route.empty()) {
+      if (q.continuous) {  // the end of a continuous path: no turn, dwell or stop there
+        r.queue.pop_front();
+        r.routed = false;
+        continue;
+      }
       VOXPLAN_RETURN_IF_ERROR(StepToView(r, q));
       continue;
     }
@@ -489,10 +518,31 @@ Status Explorer::Advance(RobotRun& r, double t_end_s) {
     const Eigen::Vector2f delta = r.route.front() - s.position_W;
     const float dist = delta.norm();
     if (dist < 1e-3f) {
-      r.route.pop_front();
+      PopWaypoint(r);
       continue;
     }
     const float dh = WrapAngle(std::atan2(delta.y(), delta.x()) - s.heading_rad);
+    // Continuous motion turns while it drives, the camera moving with it; a piece that would
+    // drive backwards (more than a right angle off) turns in place first.
+    if (q.continuous && std::abs(dh) <= 0.5f * kPi) {
+      const CameraAim aim = CameraTarget(r);
+      const float max_pitch = r.robot.max_abs_pitch_rad();
+      const float speed = r.route_speed_mps.empty() ? r.robot.mode_params().max_speed_mps
+                                                    : r.route_speed_mps.front();
+      const float piece = std::min(dist, p_.drive_step_m);
+      const Eigen::Vector2f goal =
+          piece < dist ? Eigen::Vector2f(s.position_W + delta * (piece / dist)) : r.route.front();
+      if (Status st = r.robot.DriveAlong(
+              goal, speed, s.camera_yaw_rad + WrapAngle(aim.yaw_rad - s.camera_yaw_rad),
+              std::clamp(aim.pitch_rad, -max_pitch, max_pitch));
+          !st.ok()) {
+        Blocked(r, q, goal, st);
+        continue;
+      }
+      if (piece >= dist) PopWaypoint(r);
+      VOXPLAN_RETURN_IF_ERROR(AfterPrimitive(r, c));
+      continue;
+    }
     if (std::abs(dh) > 1e-3f) {
       r.robot.TurnTo(s.heading_rad + Clamp(dh, turn_step));
       VOXPLAN_RETURN_IF_ERROR(AfterPrimitive(r, c));
@@ -514,26 +564,33 @@ Status Explorer::Advance(RobotRun& r, double t_end_s) {
     const Eigen::Vector2f goal =
         piece < dist ? Eigen::Vector2f(s.position_W + delta * (piece / dist)) : r.route.front();
     if (Status st = r.robot.DriveTo(goal); !st.ok()) {
-      if (!q.path.empty()) {
-        // The plugin's path runs closer to obstacles than the true floor allows: route this
-        // task on the known map (with its margin) instead, once.
-        result_.plan_log.push_back("t=" + Fmt(r.t_s) + " robot " + std::to_string(r.index) +
-                                   " leaves the planner's path: " + st.message());
-        q.path.clear();
-        r.routed = false;
-        continue;
-      }
-      // The host's own route, over the known map with its margin, ran into something the map
-      // lacks. (A plugin path that grazes a known wall, as above, teaches nothing: the grids
-      // of the map and the true plan are offset, and marking there narrows doorways.)
-      Bump(r, goal);
-      Fail(r, st.message());
+      Blocked(r, q, goal, st);
       continue;
     }
-    if (piece >= dist) r.route.pop_front();
+    if (piece >= dist) PopWaypoint(r);
     VOXPLAN_RETURN_IF_ERROR(AfterPrimitive(r, c));
   }
   return Status::Ok();
+}
+
+void Explorer::Blocked(RobotRun& r, QueuedTask& q, const Eigen::Vector2f& goal_W,
+                       const Status& why) {
+  ++result_.blocked_paths;
+  if (!q.path.empty()) {
+    // The plugin's path runs closer to obstacles than the true floor allows: route this task on
+    // the known map (with its margin) instead, once.
+    result_.plan_log.push_back("t=" + Fmt(r.t_s) + " robot " + std::to_string(r.index) +
+                               " leaves the planner's path: " + why.message());
+    q.path.clear();
+    q.speeds_mps.clear();
+    r.routed = false;
+    return;
+  }
+  // The host's own route, over the known map with its margin, ran into something the map lacks.
+  // (A plugin path that grazes a known wall, as above, teaches nothing: the grids of the map and
+  // the true plan are offset, and marking there narrows doorways.)
+  Bump(r, goal_W);
+  Fail(r, why.message());
 }
 
 Status Explorer::UpdateFloor() {
@@ -644,6 +701,18 @@ std::vector<std::vector<Eigen::Vector2f>> SplitPath(const std::vector<PathPoint>
   return pieces;
 }
 
+// A continuous path's waypoints and speeds: points closer than min_step_m to the last kept one
+// dropped as SplitPath does, the speed of a kept point that of the piece ending there.
+void ContinuousPiece(const RobotPlan& rp, QueuedTask* q, float min_step_m = 0.1f) {
+  for (size_t j = 0; j < rp.path.size(); ++j) {
+    const Eigen::Vector2f& p = rp.path[j].position_m;
+    if (j + 1 < rp.path.size() && !q->path.empty() && (p - q->path.back()).norm() < min_step_m)
+      continue;
+    q->path.push_back(p);
+    if (!rp.path_speed_mps.empty()) q->speeds_mps.push_back(rp.path_speed_mps[j]);
+  }
+}
+
 void Explorer::CallPlanner(PlanEvent event, int32_t event_robot, const PlannerTask& failed) {
   explore_world_.Refresh();
   explore_world_.SetRobots(Snapshot());
@@ -704,7 +773,7 @@ void Explorer::CallPlanner(PlanEvent event, int32_t event_robot, const PlannerTa
       if (replace) {
         r.queue.clear();
         r.routed = false;
-        r.route.clear();
+        ClearRoute(r);
       }
       // A dense path starts at the robot, so it only applies to tasks it will drive next.
       std::vector<std::vector<Eigen::Vector2f>> pieces(tasks.size());
@@ -713,7 +782,23 @@ void Explorer::CallPlanner(PlanEvent event, int32_t event_robot, const PlannerTa
         r.camera_trajectory = rp.camera_trajectory;
         r.trajectory_t0_s = r.t_s;
       }
+      if (rp.path_continuous && rp.tasks.empty() && r.queue.empty()) {
+        QueuedTask q{tasks.front(), {}};
+        q.continuous = true;
+        ContinuousPiece(rp, &q);
+        r.queue.push_back(std::move(q));
+        continue;
+      }
       for (size_t k = 0; k < tasks.size(); ++k) r.queue.push_back({tasks[k], pieces[k]});
+    }
+    if (!std::isnan(plan->wakeup_t_s)) {
+      constexpr double kMaxWakeupAhead_s = 600.0;
+      if (plan->wakeup_t_s > t_s_ && plan->wakeup_t_s <= t_s_ + kMaxWakeupAhead_s) {
+        wakeup_t_s_ = plan->wakeup_t_s;
+      } else {
+        result_.plan_log.push_back(head + "request_call refused: t=" + Fmt(plan->wakeup_t_s) +
+                                   " is not in (now, now + 600 s]");
+      }
     }
     result_.plan_calls.push_back(record);
     if (plan->done) {
@@ -833,6 +918,10 @@ Result<ExploreResult> Explorer::Run(const std::vector<Eigen::Vector2f>& starts) 
     if (!done_ && !called &&
         (t_s_ - last_call_s_ >= p_.planning_interval_s - 1e-9 || (all_idle && empty_calls_ > 0))) {
       CallPlanner(PlanEvent::kInterval, -1, {});
+    }
+    if (!done_ && wakeup_t_s_ <= t_s_ + 1e-9) {  // NaN (none asked) compares false
+      wakeup_t_s_ = std::numeric_limits<double>::quiet_NaN();
+      CallPlanner(PlanEvent::kWakeup, -1, {});
     }
 
     if (t_s_ >= next_series_s - 1e-9) {
@@ -1001,6 +1090,8 @@ const char* PlanEventName(PlanEvent event) {
       return "start";
     case PlanEvent::kInterval:
       return "interval";
+    case PlanEvent::kWakeup:
+      return "wakeup";
     case PlanEvent::kRobotIdle:
       return "robot_idle";
     case PlanEvent::kTaskFailed:

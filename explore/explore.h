@@ -158,9 +158,12 @@ struct ExploreResult {
   size_t failed_tasks = 0;
   size_t rejected_tasks = 0;
   size_t over_budget_calls = 0;
-  size_t blocks_dropped = 0;       // map blocks not allocated: the map was at max_memory_bytes
-  size_t failed_plans = 0;         // plan calls the plugin failed (messages in plan_log)
-  std::vector<RobotTrack> tracks;  // one per robot: r0, r1, ...
+  size_t blocks_dropped = 0;  // map blocks not allocated: the map was at max_memory_bytes
+  size_t failed_plans = 0;    // plan calls the plugin failed (messages in plan_log)
+  // Drives the true floor refused (a planner's path or the host's route ran into an obstacle;
+  // Xu 2017's blocked paths): each leaves the path, re-routes or fails its task.
+  size_t blocked_paths = 0;
+  std::vector<RobotTrack> tracks;                    // one per robot: r0, r1, ...
   std::vector<std::vector<ExploreFrame>> frames;     // per robot, every frame it fused
   std::vector<std::vector<PlannerTask>> task_views;  // per robot, views it reached, in order
   std::vector<PlanCallRecord> plan_calls;

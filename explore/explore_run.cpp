@@ -188,7 +188,7 @@ Result<ApartmentParams> ParseApartmentSpec(const std::string& spec) {
         return InvalidArgument("--scene " + spec + ": seed wants a non-negative integer");
     } else {
       return InvalidArgument("--scene " + spec + ": unknown key '" + key +
-                             "' (apartment:size=S|M|L|XL,seed=N)");
+                             "' (apartment:size=S|M|L|XL|R,seed=N)");
     }
   }
   return params;

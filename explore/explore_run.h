@@ -27,7 +27,8 @@
 namespace voxplan {
 
 struct ExploreRunParams {
-  // "apartment:size=S|M|L,seed=N" (parametric furniture: needs no shared data) or a scene file.
+  // "apartment:size=S|M|L|XL|R,seed=N" (parametric furniture: needs no shared data) or a scene
+  // file.
   std::string scene;
   SceneLoadOptions scene_load;  // how a scene file loads
   int robots = 3;

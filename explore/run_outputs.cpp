@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "core/summary.h"
+#include "eval/path_smoothness.h"
 #include "explore/robot_config.h"
 #include "io/file_util.h"
 #include "io/image_io.h"
@@ -103,6 +104,17 @@ json MetricsObject(const ExploreRunParams& params, const ExploreRunReport& repor
   m["mode_time_s"] = mode_time;
   m["mode_distance_m"] = mode_distance;
   m["mode_switches"] = metrics.mode_switches;
+  // Path smoothness of the team (Xu 2017 X§7), weighted by each robot's time and travel.
+  PathSmoothness base, camera;
+  for (const RobotTrack& track : r.tracks) {
+    base = CombineSmoothness(base, BaseSmoothness(track));
+    camera = CombineSmoothness(camera, CameraSmoothness(track));
+  }
+  m["base_ang_accel_radps2"] = RoundTo(base.mean_abs_angular_accel_radps2, 4);
+  m["base_turning_per_m"] = RoundTo(base.turning_per_m, 4);
+  m["base_sharp_turns_per_10m"] = RoundTo(base.sharp_turns_per_10m, 3);
+  m["camera_ang_accel_radps2"] = RoundTo(camera.mean_abs_angular_accel_radps2, 4);
+  m["camera_turning_per_m"] = RoundTo(camera.turning_per_m, 4);
   m["coverage"] = r.series.empty() ? 0.0 : RoundTo(r.series.back().coverage, 4);
   m["plan_calls"] = r.plan_calls.size();
   m["plan_ms_median"] = RoundTo(plan_summary.median, 3);  // wall time: varies run to run
@@ -111,6 +123,7 @@ json MetricsObject(const ExploreRunParams& params, const ExploreRunReport& repor
   m["rejected_tasks"] = r.rejected_tasks;
   m["failed_tasks"] = r.failed_tasks;
   m["failed_plan_calls"] = r.failed_plans;
+  m["blocked_paths"] = r.blocked_paths;
   m["frames_fused"] = r.frames_fused;
   m["objects_detected"] = r.objects_detected;
   m["blocks_dropped_memory"] = r.blocks_dropped;

@@ -86,10 +86,11 @@ enum { VP_VOXEL_UNOBSERVED = 0, VP_VOXEL_FREE = 1, VP_VOXEL_OCCUPIED = 2 };
 enum { VP_FLOOR_UNKNOWN = 0, VP_FLOOR_FREE = 1, VP_FLOOR_FRONTIER = 2, VP_FLOOR_OBSTACLE = 3 };
 /* Why plan() was called. */
 enum {
-  VP_EVENT_START = 0,      /* first call of a run */
-  VP_EVENT_INTERVAL = 1,   /* the re-planning interval elapsed */
-  VP_EVENT_ROBOT_IDLE = 2, /* event_robot finished its queue (task-flow, Guo 2022) */
-  VP_EVENT_TASK_FAILED = 3 /* event_robot could not reach or execute failed_task */
+  VP_EVENT_START = 0,       /* first call of a run */
+  VP_EVENT_INTERVAL = 1,    /* the re-planning interval elapsed */
+  VP_EVENT_ROBOT_IDLE = 2,  /* event_robot finished its queue (task-flow, Guo 2022) */
+  VP_EVENT_TASK_FAILED = 3, /* event_robot could not reach or execute failed_task */
+  VP_EVENT_WAKEUP = 4       /* the time the plugin asked for came (vp.schedule request_call) */
 };
 enum { VP_ROBOT_IDLE = 0, VP_ROBOT_EXECUTING = 1 };
 /* Scanning modes (Guo 2022); a robot may have more, see vp_robot.mode_count. */
@@ -350,6 +351,39 @@ typedef struct vp_task_ext_table {
   vp_status (*get_robot_queue_ext)(const vp_world* w, uint32_t robot, const vp_task_ext** out,
                                    uint32_t* out_count);
 } vp_task_ext_table;
+
+/* "vp.motion" version 1: paths driven without stopping (Xu 2017's advected paths). A continuous
+ * path without tasks is followed point to point with the base turning while it drives (each
+ * piece takes the longer of its length at the point's speed and its turn at the mode's turn
+ * rate), the camera aiming along the camera trajectory at the same time; it ends at its last
+ * point without a final turn, dwell or capture stop, and the next path or task starts from there.
+ * Frames are taken at the mode's capture rate while driving. */
+#define VP_EXT_MOTION "vp.motion"
+#define VP_PATH_CONTINUOUS 1u
+typedef struct vp_path_ext {
+  uint32_t struct_size;
+  uint32_t flags;         /* VP_PATH_* */
+  const float* speed_mps; /* per point (count of them), > 0; NULL: the mode's speed. Clamped to
+                           * the mode's max_speed_mps. The speed of point i is that of the piece
+                           * that ends there. */
+} vp_path_ext;
+
+typedef struct vp_motion_ext {
+  vp_extension_header header;
+  /* set_path with how to drive it; ext may be NULL (as set_path). */
+  vp_status (*set_path_ext)(vp_plan_output* o, uint32_t robot, const vp_path_point* points,
+                            uint32_t count, const vp_path_ext* ext);
+} vp_motion_ext;
+
+/* "vp.schedule" version 1: the plugin picks when it is called next (Xu 2017's sub-steps). */
+#define VP_EXT_SCHEDULE "vp.schedule"
+typedef struct vp_schedule_ext {
+  vp_extension_header header;
+  /* A call with event VP_EVENT_WAKEUP at the first loop step at or after t_s (the run clock of
+   * vp_call_info.t_s), replacing an earlier request; other events may come first and do not
+   * cancel it. Refused (logged, nothing scheduled) unless now < t_s <= now + 600 s. */
+  vp_status (*request_call)(vp_plan_output* o, double t_s);
+} vp_schedule_ext;
 
 /* Whether a host table has a field: a plugin that also runs on older hosts of its major version
  * tests this before calling an appended function. */

@@ -291,15 +291,26 @@ class PlanOutput {
   }
   // vp.task 1: a task with its camera part (DefaultTaskExt() for the fields left alone).
   void AddTask(uint32_t robot, const vp_task& task, const vp_task_ext& camera) {
-    const vp_extension_header* h = host_->get_extension(VP_EXT_TASK, 1);
-    if (h == nullptr || h->struct_size < sizeof(vp_task_ext_table))
-      throw Error(VP_ERROR_NOT_AVAILABLE,
-                  "this host has no extension vp.task version 1; run it with a newer voxplan");
-    Check(reinterpret_cast<const vp_task_ext_table*>(h)->add_task_ext(out_, robot, &task, &camera),
+    Check(Table<vp_task_ext_table>(VP_EXT_TASK).add_task_ext(out_, robot, &task, &camera),
           "add_task_ext");
   }
   void SetPath(uint32_t robot, std::span<const vp_path_point> points) {
     Check(host_->set_path(out_, robot, points.data(), uint32_t(points.size())), "set_path");
+  }
+  // vp.motion 1: a path driven without stopping, at a speed per point (empty: the mode's).
+  void SetContinuousPath(uint32_t robot, std::span<const vp_path_point> points,
+                         std::span<const float> speeds_mps = {}) {
+    if (!speeds_mps.empty() && speeds_mps.size() != points.size())
+      throw Error(VP_ERROR_INVALID_ARGUMENT, "SetContinuousPath: one speed per point");
+    const vp_path_ext ext = {sizeof(vp_path_ext), VP_PATH_CONTINUOUS,
+                             speeds_mps.empty() ? nullptr : speeds_mps.data()};
+    Check(Table<vp_motion_ext>(VP_EXT_MOTION)
+              .set_path_ext(out_, robot, points.data(), uint32_t(points.size()), &ext),
+          "set_path_ext");
+  }
+  // vp.schedule 1: be called (VP_EVENT_WAKEUP) at run time t_s.
+  void RequestCall(double t_s) {
+    Check(Table<vp_schedule_ext>(VP_EXT_SCHEDULE).request_call(out_, t_s), "request_call");
   }
   void SetCameraTrajectory(uint32_t robot, std::span<const vp_camera_sample> samples) {
     Check(host_->set_camera_trajectory(out_, robot, samples.data(), uint32_t(samples.size())),
@@ -325,6 +336,15 @@ class PlanOutput {
   }
 
  private:
+  // An output-side extension table at version 1 or later; refused with the reason otherwise.
+  template <typename T>
+  const T& Table(const char* name) const {
+    const vp_extension_header* h = host_->get_extension(name, 1);
+    if (h == nullptr || h->struct_size < sizeof(T))
+      throw Error(VP_ERROR_NOT_AVAILABLE, std::string("this host has no extension ") + name +
+                                              " version 1; run it with a newer voxplan");
+    return *reinterpret_cast<const T*>(h);
+  }
   const vp_host_api* host_;
   vp_plan_output* out_;
 };

@@ -308,6 +308,35 @@ Status Robot::DriveTo(const Eigen::Vector2f& goal_W) {
   return Status::Ok();
 }
 
+Status Robot::DriveAlong(const Eigen::Vector2f& goal_W, float speed_mps, float camera_yaw_rad,
+                         float camera_pitch_rad) {
+  if (!goal_W.allFinite() || !(speed_mps > 0.f) || !std::isfinite(camera_yaw_rad))
+    return InvalidArgument("Robot::DriveAlong: goal, speed or camera yaw is not valid");
+  if (!(std::abs(camera_pitch_rad) <= max_abs_pitch_rad()))
+    return InvalidArgument("Robot::DriveAlong: pitch beyond the limit");
+  const Eigen::Vector2f delta = goal_W - state_.position_W;
+  const float length = delta.norm();
+  if (length > 0.f && !SegmentFree(plan_, state_.position_W, goal_W, params_.radius_m))
+    return InvalidArgument("Robot::DriveAlong: path " + Point(state_.position_W) + " -> " +
+                           Point(goal_W) + " collides with the floor plan");
+  const ModeParams& m = mode_params();
+  const float turn =
+      length > 0.f ? WrapAngle(std::atan2(delta.y(), delta.x()) - state_.heading_rad) : 0.f;
+  const double duration = std::max(
+      {double(length) / std::min(speed_mps, m.max_speed_mps),
+       double(std::abs(turn)) / m.max_turn_rate_radps,
+       double(std::abs(camera_yaw_rad - state_.camera_yaw_rad)) / params_.camera_yaw_rate_radps,
+       double(std::abs(camera_pitch_rad - state_.camera_pitch_rad)) /
+           params_.camera_pitch_rate_radps});
+  clock_s_ += duration;
+  distance_m_ += length;
+  state_.position_W = goal_W;
+  state_.heading_rad += turn;
+  state_.camera_yaw_rad = camera_yaw_rad;
+  state_.camera_pitch_rad = camera_pitch_rad;
+  return Status::Ok();
+}
+
 void Robot::SetCameraYaw(float yaw_rad) {
   clock_s_ += std::abs(yaw_rad - state_.camera_yaw_rad) / params_.camera_yaw_rate_radps;
   state_.camera_yaw_rad = yaw_rad;

@@ -141,6 +141,13 @@ class Robot {
   // Turns towards the goal, then drives straight at the mode's speed. Refuses (state and clock
   // unchanged) a goal whose straight segment the footprint cannot pass.
   Status DriveTo(const Eigen::Vector2f& goal_W);
+  // One piece of continuous motion (a followed path, Xu 2017): drives straight to the goal while
+  // the base turns to the piece's direction and the camera joints move to their targets, all at
+  // once, so the piece takes the longest of length / speed (clamped to the mode's), the base's
+  // turn at its rate and each joint's move at its rate. Refuses (state and clock unchanged) what
+  // DriveTo refuses and a pitch beyond the limit.
+  Status DriveAlong(const Eigen::Vector2f& goal_W, float speed_mps, float camera_yaw_rad,
+                    float camera_pitch_rad);
   // Camera joints; each costs |Δangle| / joint rate. Pitch beyond the limit is refused.
   void SetCameraYaw(float yaw_rad);
   Status SetCameraPitch(float pitch_rad);

@@ -273,9 +273,10 @@ Command AddExploreCommand(CLI::App& app) {
   auto positive = [sub](const char* name, double& value, const char* help) {
     sub->add_option(name, value, help)->check(InRange(1e-6, 1e6))->capture_default_str();
   };
-  sub->add_option("--scene", run.scene,
-                  "apartment:size=S|M|L,seed=N, or a scene file (.ply .glb .obj .dae), Z-up metres "
-                  "by default")
+  sub->add_option(
+         "--scene", run.scene,
+         "apartment:size=S|M|L|XL|R,seed=N, or a scene file (.ply .glb .obj .dae), Z-up metres "
+         "by default")
       ->required();
   AddSceneFrameOptions(sub, o->frame);
   sub->add_option("--robots", run.robots, "Number of robots")

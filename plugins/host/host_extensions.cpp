@@ -85,6 +85,52 @@ const vp_task_ext_table kTask = {
     .get_robot_queue_ext = GetRobotQueueExt,
 };
 
+// ---- vp.motion 1. -----------------------------------------------------------------------------
+
+vp_status SetPathExt(vp_plan_output* o, uint32_t robot, const vp_path_point* points, uint32_t count,
+                     const vp_path_ext* ext) {
+  if (ext && ext->struct_size < sizeof(uint32_t)) return VP_ERROR_STRUCT_SIZE;
+  const vp_status s = PlannerHostApi().set_path(o, robot, points, count);
+  if (s != VP_OK) return s;
+  return Guarded([&]() -> vp_status {
+    RobotPlan& plan = o->result->robots[robot];  // set_path checked o and robot
+    plan.path_continuous = false;
+    plan.path_speed_mps.clear();
+    if (!ext) return VP_OK;
+    // Fields past what the plugin's struct holds keep their defaults.
+    const auto has = [&](const auto& field) {
+      return ext->struct_size >=
+             uint32_t(reinterpret_cast<const char*>(&field) - reinterpret_cast<const char*>(ext)) +
+                 uint32_t(sizeof(field));
+    };
+    if (has(ext->flags)) plan.path_continuous = (ext->flags & VP_PATH_CONTINUOUS) != 0;
+    if (has(ext->speed_mps) && ext->speed_mps) {
+      plan.path_speed_mps.assign(ext->speed_mps, ext->speed_mps + count);  // validated later
+    }
+    return VP_OK;
+  });
+}
+
+const vp_motion_ext kMotion = {
+    .header = {.struct_size = sizeof(vp_motion_ext), .version = 1},
+    .set_path_ext = SetPathExt,
+};
+
+// ---- vp.schedule 1. ---------------------------------------------------------------------------
+
+vp_status RequestCall(vp_plan_output* o, double t_s) {
+  return Guarded([&]() -> vp_status {
+    if (!o || !o->result) return VP_ERROR_INVALID_ARGUMENT;
+    o->result->wakeup_t_s = t_s;  // the loop checks it against its clock
+    return VP_OK;
+  });
+}
+
+const vp_schedule_ext kSchedule = {
+    .header = {.struct_size = sizeof(vp_schedule_ext), .version = 1},
+    .request_call = RequestCall,
+};
+
 // ---- The registry. ----------------------------------------------------------------------------
 
 struct Extension {
@@ -95,6 +141,8 @@ struct Extension {
 constexpr Extension kExtensions[] = {
     {VP_EXT_OBJECTS, &kObjects.header},
     {VP_EXT_TASK, &kTask.header},
+    {VP_EXT_MOTION, &kMotion.header},
+    {VP_EXT_SCHEDULE, &kSchedule.header},
 };
 
 }  // namespace

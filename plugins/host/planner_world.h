@@ -78,7 +78,13 @@ struct PlannerFloor {
 };
 
 enum class TaskPolicy : int32_t { kAppend = 0, kReplace = 1 };
-enum class PlanEvent : int32_t { kStart = 0, kInterval = 1, kRobotIdle = 2, kTaskFailed = 3 };
+enum class PlanEvent : int32_t {
+  kStart = 0,
+  kInterval = 1,
+  kRobotIdle = 2,
+  kTaskFailed = 3,
+  kWakeup = 4
+};
 
 // Where the camera is at a task (vp_task_ext, extension vp.task); the defaults leave it where
 // the mount puts it.

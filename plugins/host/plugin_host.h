@@ -23,6 +23,7 @@
 #include <cstdint>
 #include <filesystem>
 #include <functional>
+#include <limits>
 #include <memory>
 #include <optional>
 #include <string>
@@ -103,6 +104,10 @@ struct RobotPlan {
   TaskPolicy policy = TaskPolicy::kAppend;
   std::vector<PlannerTask> tasks;  // validated, in the plugin's order
   std::vector<PathPoint> path;     // optional dense path
+  // vp.motion: driven without stopping (VP_PATH_CONTINUOUS), at these speeds (one per path
+  // point, or empty for the mode's speed).
+  bool path_continuous = false;
+  std::vector<float> path_speed_mps;
   std::vector<CameraSample> camera_trajectory;
 };
 
@@ -137,6 +142,8 @@ struct PlanResult {
   std::vector<PlanLogEntry> log;  // the plugin's messages, then the host's rejections
   double elapsed_ms = 0.0;
   bool over_budget = false;
+  // vp.schedule: the run time the plugin asked to be called at; NaN when it did not ask.
+  double wakeup_t_s = std::numeric_limits<double>::quiet_NaN();
 };
 
 struct PlanValidation {

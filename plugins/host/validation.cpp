@@ -163,7 +163,23 @@ void Validate(const PlannerWorld& world, const std::vector<PlannerRobot>& robots
         Reject(result, planner, int32_t(r), -1,
                "path dropped: point " + std::to_string(i) + " is not finite");
         plan.path.clear();
+        plan.path_speed_mps.clear();
+        plan.path_continuous = false;
         break;
+      }
+    }
+    if (!plan.path_speed_mps.empty()) {
+      // vp.motion speeds: one per point, each a positive speed a robot could have.
+      constexpr float kMaxSpeed_mps = 10.f;
+      bool ok = plan.path_speed_mps.size() == plan.path.size();
+      for (const float speed : plan.path_speed_mps)
+        ok = ok && speed > 0.f && speed <= kMaxSpeed_mps;
+      if (!ok) {
+        Reject(result, planner, int32_t(r), -1,
+               "path dropped: its speeds must be one per point, each in (0, 10] m/s");
+        plan.path.clear();
+        plan.path_speed_mps.clear();
+        plan.path_continuous = false;
       }
     }
     for (size_t i = 0; i < plan.camera_trajectory.size(); ++i) {

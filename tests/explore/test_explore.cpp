@@ -322,6 +322,126 @@ TEST(Explore, BumperPutsAnObstacleTheCameraNeverSeesOnTheMap) {
   EXPECT_LE(run->failed_tasks, bumps);  // each failure here is a bump that marked something new
 }
 
+// A 1.2 m leg at 45° (the robot starts heading along +x) with room on both sides.
+bool DiagonalLeg(const FloorPlan& plan, float clearance_m, Eigen::Vector2f* start,
+                 Eigen::Vector2f* goal) {
+  const Eigen::Vector2f dir = Eigen::Vector2f(1.f, 1.f).normalized();
+  for (int i = 0; i < plan.width * plan.height; ++i) {
+    const Eigen::Vector2f c = plan.CellCenter(i % plan.width, i / plan.width);
+    if (SegmentFree(plan, c, c + 1.2f * dir, clearance_m)) {
+      *start = c;
+      *goal = c + 1.2f * dir;
+      return true;
+    }
+  }
+  return false;
+}
+
+// Intervals of the track where the base both moved and turned.
+int TurningMoves(const RobotTrack& track) {
+  int n = 0;
+  for (size_t i = 0; i + 1 < track.samples.size(); ++i) {
+    const RobotSample& a = track.samples[i];
+    const RobotSample& b = track.samples[i + 1];
+    n += std::hypot(b.x_m - a.x_m, b.y_m - a.y_m) > 0.02 && std::abs(b.yaw_rad - a.yaw_rad) > 0.05;
+  }
+  return n;
+}
+
+TEST(Explore, ContinuousPathTurnsWhileDrivingAtItsSpeedAndEndsWithoutAStop) {
+  // vp.motion: the same leg driven stop-and-go (a task, routed by the host) and as a continuous
+  // path. Continuous, the 45° turn happens while driving; it arrives heading along the path, and
+  // each piece takes its length at the path's speed (the mode's, or the one given).
+  const Scene& s = SmallApartment();
+  ExploreParams params = FastParams();
+  params.max_time_s = 120.0;
+  Eigen::Vector2f start, goal;
+  ASSERT_TRUE(DiagonalLeg(s.plan, params.robot.radius_m + 0.3f, &start, &goal));
+  auto drive = [&](const std::string& extra) {
+    std::unique_ptr<LoadedPlanner> planner = Goto(goal, extra);
+    EXPECT_TRUE(planner);
+    Result<ExploreResult> run = RunExplore(s.world, s.plan, {start}, *planner, params, {});
+    EXPECT_TRUE(run.ok()) << run.status().message();
+    return std::move(run).value();
+  };
+  const ExploreResult stop_and_go = drive("");
+  const ExploreResult continuous = drive("\"continuous\": 1");
+  const ExploreResult slow = drive("\"continuous\": 1, \"speed\": 0.1");
+  for (const ExploreResult* run : {&stop_and_go, &continuous, &slow}) {
+    EXPECT_EQ(run->terminated, "done");
+    const RobotSample& end = run->tracks[0].samples.back();
+    EXPECT_LT((Eigen::Vector2f(float(end.x_m), float(end.y_m)) - goal).norm(), 1e-3f);
+    EXPECT_NEAR(end.yaw_rad, M_PI / 4, 1e-3);
+    EXPECT_EQ(run->blocked_paths, 0u);
+  }
+  EXPECT_EQ(TurningMoves(stop_and_go.tracks[0]), 0);  // turns in place, then drives
+  EXPECT_GE(TurningMoves(continuous.tracks[0]), 1);
+  // After the first piece (which also brings the base and camera round from the start sweep,
+  // the slowest of those moves setting its time) every piece takes its length at its speed.
+  auto off_speed = [](const RobotTrack& track, double speed_mps, int* pieces) {
+    int off = 0;
+    bool first = true;
+    *pieces = 0;
+    for (size_t i = 0; i + 1 < track.samples.size(); ++i) {
+      const RobotSample& a = track.samples[i];
+      const RobotSample& b = track.samples[i + 1];
+      const double length = std::hypot(b.x_m - a.x_m, b.y_m - a.y_m);
+      if (length == 0.0) continue;
+      if (first) {
+        first = false;
+        continue;
+      }
+      ++*pieces;
+      off += std::abs((b.t_s - a.t_s) - length / speed_mps) > 1e-3;
+    }
+    return off;
+  };
+  int pieces = 0;
+  EXPECT_EQ(off_speed(continuous.tracks[0], params.robot.explorer.max_speed_mps, &pieces), 0);
+  EXPECT_GE(pieces, 4);  // 1.2 m in 0.2 m pieces, the first aside
+  EXPECT_EQ(off_speed(slow.tracks[0], 0.1, &pieces), 0);
+  EXPECT_GE(pieces, 4);
+}
+
+TEST(Explore, RequestedCallsComeAtTheFirstStepAfterTheirTime) {
+  // vp.schedule: goto asks to be called 1.3 s after each call; the loop steps by step_s, so each
+  // wakeup comes in [1.3, 1.3 + step_s) after the call before it. A request past 600 s ahead is
+  // refused with a log line.
+  const Scene& s = SmallApartment();
+  ExploreParams params = FastParams();
+  params.max_time_s = 30.0;
+  Eigen::Vector2f start, goal;
+  ASSERT_TRUE(DiagonalLeg(s.plan, params.robot.radius_m + 0.3f, &start, &goal));
+  // A slow drive keeps the robot busy (goto is done once it stands at the goal).
+  std::unique_ptr<LoadedPlanner> planner =
+      Goto(goal, "\"wakeup\": 1.3, \"speed\": 0.02, \"continuous\": 1");
+  ASSERT_TRUE(planner);
+  Result<ExploreResult> run = RunExplore(s.world, s.plan, {start}, *planner, params, {});
+  ASSERT_TRUE(run.ok()) << run.status().message();
+  int wakeups = 0;
+  const std::vector<PlanCallRecord>& calls = run->plan_calls;
+  for (size_t k = 1; k < calls.size(); ++k) {
+    const double gap = calls[k].t_s - calls[k - 1].t_s;
+    // Every call asks for the next 1.3 s on: no call waits longer than that and a step.
+    EXPECT_LT(gap, 1.3 + params.step_s + 1e-9) << "call " << k;
+    if (calls[k].event != PlanEvent::kWakeup) continue;
+    ++wakeups;
+    EXPECT_GE(gap, 1.3 - 1e-9) << "call " << k;
+  }
+  EXPECT_GE(wakeups, 5);
+
+  std::unique_ptr<LoadedPlanner> far = Goto(goal, "\"wakeup\": 700");
+  ASSERT_TRUE(far);
+  params.max_time_s = 5.0;
+  Result<ExploreResult> refused = RunExplore(s.world, s.plan, {start}, *far, params, {});
+  ASSERT_TRUE(refused.ok()) << refused.status().message();
+  int refusals = 0;
+  for (const std::string& line : refused->plan_log)
+    refusals += line.find("request_call refused") != std::string::npos;
+  EXPECT_GE(refusals, 1);
+  for (const PlanCallRecord& c : refused->plan_calls) EXPECT_NE(c.event, PlanEvent::kWakeup);
+}
+
 TEST(Explore, PlannersSeeTheExplorerCamera) {
   const Scene& s = SmallApartment();
   ExploreParams params = FastParams();

@@ -201,6 +201,9 @@ TEST(PluginHost, GarbageIsRejectedAndLoggedAndTheRestKept) {
       task_reasons[r.task] = r.reason;
     } else {
       ++other;
+      if (r.robot == 1) {
+        EXPECT_TRUE(Contains(r.reason, "speeds")) << r.reason;
+      }
     }
   }
   ASSERT_EQ(task_reasons.size(), 8u);
@@ -212,7 +215,9 @@ TEST(PluginHost, GarbageIsRejectedAndLoggedAndTheRestKept) {
   EXPECT_TRUE(Contains(task_reasons[6], "outside the map bounds"));
   EXPECT_TRUE(Contains(task_reasons[7], "mode 7 unknown"));
   EXPECT_TRUE(Contains(task_reasons[8], "dwell"));
-  EXPECT_EQ(other, 3);  // the path, the NaN diagnostic, the NaN drawing
+  EXPECT_EQ(other, 4);  // the path, robot 1's speeds, the NaN diagnostic, the NaN drawing
+  EXPECT_TRUE(result->robots[1].path.empty());
+  EXPECT_FALSE(result->robots[1].path_continuous);
   const auto d = Diagnostics(*result);
   EXPECT_EQ(d.count("energy"), 0u);
   EXPECT_EQ(d.at("iterations"), 3.0);
@@ -385,6 +390,18 @@ TEST(PluginCppLayer, AMissingOrShortExtensionIsAClearError) {
   ASSERT_NE(real, nullptr);
   EXPECT_EQ(real->struct_size, sizeof(vp_objects_ext));
   EXPECT_EQ(real->version, 1u);
+  // Every extension this header names is there, whole, at version 1 (and not at 2).
+  const std::pair<const char*, uint32_t> tables[] = {{VP_EXT_OBJECTS, sizeof(vp_objects_ext)},
+                                                     {VP_EXT_TASK, sizeof(vp_task_ext_table)},
+                                                     {VP_EXT_MOTION, sizeof(vp_motion_ext)},
+                                                     {VP_EXT_SCHEDULE, sizeof(vp_schedule_ext)}};
+  for (const auto& [name, size] : tables) {
+    const vp_extension_header* t = PlannerHostApi().get_extension(name, 1);
+    ASSERT_NE(t, nullptr) << name;
+    EXPECT_EQ(t->struct_size, size) << name;
+    EXPECT_EQ(t->version, 1u) << name;
+    EXPECT_EQ(PlannerHostApi().get_extension(name, 2), nullptr) << name;
+  }
 }
 
 TEST(PluginHost, DeterministicForASeed) {

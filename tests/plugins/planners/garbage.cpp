@@ -1,7 +1,8 @@
 // Returns garbage next to one good task, for robot 0 of any world with a floor: a NaN, a task
 // in an obstacle, one in unknown space, one too close to a wall, one in a free cell it cannot
 // reach, one outside the bounds, a bad mode, a negative dwell; a path with an infinity, a NaN
-// diagnostic and a NaN debug point. The host must keep only the good task (tag 1).
+// diagnostic and a NaN debug point; for robot 1 a continuous path with a zero speed. The host must
+// keep only the good task (tag 1).
 #include <cmath>
 #include <limits>
 #include <vector>
@@ -52,6 +53,13 @@ class Garbage : public vp::Planner {
     const vp_path_point path[2] = {{robot.x_m, robot.y_m, 0.f},
                                    {std::numeric_limits<float>::infinity(), 0.f, 0.f}};
     out.SetPath(0, path);
+    // Robot 1 (vp.motion): a continuous path with a speed of zero, dropped whole.
+    if (world.RobotCount() > 1) {
+      const vp_robot r1 = world.Robot(1);
+      const vp_path_point slow[2] = {{r1.x_m, r1.y_m, 0.f}, {r1.x_m + 0.1f, r1.y_m, 0.f}};
+      const float speeds[2] = {0.3f, 0.f};
+      out.SetContinuousPath(1, slow, speeds);
+    }
     out.Diagnostic("energy", std::nan(""));
     out.Diagnostic("iterations", 3.0);
     const float points[6] = {0.f, 0.f, 0.f, nan, 1.f, 1.f};

@@ -3,11 +3,15 @@
 // done once the robot stands there. Reports the explorer camera it was shown as diagnostics.
 // Optional keys give the task a mode ("mode"), a dwell ("dwell") and a camera part (vp.task):
 // "height", "offset_x"/"offset_y" (arm), "look_x"/"look_y"/"look_z", "sweep_min"/"sweep_max"/
-// "sweep_step" (radians).
+// "sweep_step" (radians). vp.motion and vp.schedule: "continuous": 1 sends a straight path to the
+// goal (points every 0.2 m, no tasks) to be driven without stopping, at "speed" (m/s) when given;
+// "wakeup": dt asks to be called dt seconds after every call.
+#include <algorithm>
 #include <cmath>
 #include <cstdlib>
 #include <limits>
 #include <string>
+#include <vector>
 
 #include "plugins/planner_cpp.h"
 
@@ -51,12 +55,16 @@ class Goto : public vp::Planner {
     }
     with_ext_ = !std::isnan(ext_.camera_height_m) || !std::isnan(ext_.camera_offset_m[0]) ||
                 ext_.look_at || ext_.sweep_pitch_step_rad != 0.f;
+    continuous_ = OptionalNumber(j, "continuous") == 1.f;
+    speed_mps_ = OptionalNumber(j, "speed");
+    wakeup_s_ = OptionalNumber(j, "wakeup");
   }
 
   void Plan(const vp::WorldView& world, vp::PlanOutput& out) override {
     const vp_mode_params camera = world.Mode(0, VP_MODE_EXPLORER);
     out.Diagnostic("explorer_fov_rad", camera.horizontal_fov_rad);
     out.Diagnostic("explorer_max_range_m", camera.max_range_m);
+    if (!std::isnan(wakeup_s_)) out.RequestCall(world.call().sim_time_s + wakeup_s_);
     const vp_robot robot = world.Robot(0);
     if (robot.status != VP_ROBOT_IDLE) return;
     if (std::hypot(robot.x_m - x_m_, robot.y_m - y_m_) < 1e-3f) {
@@ -66,6 +74,17 @@ class Goto : public vp::Planner {
     const vp_task task{
         x_m_, y_m_, std::atan2(y_m_ - robot.y_m, x_m_ - robot.x_m), 0.f, 0.f, dwell_s_, mode_, 0};
     out.ReplaceTasks(0);
+    if (continuous_) {
+      const float dx = x_m_ - robot.x_m, dy = y_m_ - robot.y_m;
+      const int n = std::max(1, int(std::ceil(std::hypot(dx, dy) / 0.2f)));
+      std::vector<vp_path_point> points;
+      for (int k = 1; k <= n; ++k)
+        points.push_back({robot.x_m + dx * float(k) / float(n),
+                          robot.y_m + dy * float(k) / float(n), task.theta_rad});
+      const std::vector<float> speeds(std::isnan(speed_mps_) ? 0 : points.size(), speed_mps_);
+      out.SetContinuousPath(0, points, speeds);
+      return;
+    }
     if (with_ext_) {
       out.AddTask(0, task, ext_);
     } else {
@@ -79,6 +98,8 @@ class Goto : public vp::Planner {
   float dwell_s_ = 0.f;
   vp_task_ext ext_{};
   bool with_ext_ = false;
+  bool continuous_ = false;
+  float speed_mps_ = 0.f, wakeup_s_ = 0.f;  // NaN: not asked for
 };
 
 }  // namespace
