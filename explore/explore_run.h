@@ -57,6 +57,9 @@ struct ExploreRunReport {
   ExploreResult loop;      // the loop's result, final maps included
   Mesh mesh;               // the fused map's final mesh (mesh.ply)
   MeshEvalResult quality;  // all zero when the mesh is empty
+  // Completeness over the observable surface below the robot's height (floor map band top),
+  // Xu 2017's reference; 0 when the mesh is empty.
+  double completeness_below_robot = 0.0;
   // Per object (Guo 2022's O-Comp at 2 cm, extra threshold 5 cm, and O-RMS) on the same mesh;
   // empty when the mesh is or the world has no object beside its structure.
   std::optional<ObjectsEvalResult> objects;

@@ -69,6 +69,7 @@ json MetricsObject(const ExploreRunParams& params, const ExploreRunReport& repor
   m["seed"] = params.explore.seed;
   m["completeness"] = RoundTo(quality.completeness, 4);
   m["completeness_all"] = RoundTo(quality.completeness_all, 4);
+  m["completeness_below_robot"] = RoundTo(report.completeness_below_robot, 4);
   m["completeness_reference"] =
       report.observable_reference
           ? "ground-truth surface observable from a sim tour of the reachable floor (" +

@@ -118,6 +118,16 @@ TEST(ExploreRun, ShortRunWritesEveryArtefactAndItsMetricsAgree) {
   EXPECT_NEAR(m["completeness"].get<double>(), report->quality.completeness, 5e-5);
   EXPECT_NEAR(m["distance_total_m"].get<double>(), report->metrics.distance_total_m, 5e-4);
   EXPECT_NE(m["completeness_reference"].get<std::string>().find("sim tour"), std::string::npos);
+  // Below the robot's height (Xu 2017's reference): a subset of the observable surface, so a
+  // share of it; a short run sees the walls' lower parts better than the rest.
+  EXPECT_GT(m["completeness_below_robot"].get<double>(), 0.0);
+  EXPECT_LE(m["completeness_below_robot"].get<double>(), 1.0);
+  EXPECT_NE(m["completeness_below_robot"].get<double>(), m["completeness"].get<double>());
+  // Path smoothness: two robots that turned and drove.
+  EXPECT_GT(m["base_ang_accel_radps2"].get<double>(), 0.0);
+  EXPECT_GT(m["base_turning_per_m"].get<double>(), 0.0);
+  EXPECT_GT(m["camera_ang_accel_radps2"].get<double>(), 0.0);
+  EXPECT_EQ(m["blocked_paths"], loop.blocked_paths);
   // Per object (Guo 2022): the apartment's furniture, a looser threshold covers more.
   ASSERT_TRUE(report->objects.has_value());
   EXPECT_GT(m["objects_evaluated"].get<int>(), 5);
