@@ -5,12 +5,17 @@
 #include <cmath>
 #include <deque>
 #include <limits>
+#include <map>
+#include <memory>
 #include <numbers>
+#include <optional>
 #include <sstream>
+#include <stdexcept>
 #include <utility>
 
 #include "core/bounds.h"
 #include "core/queries.h"
+#include "core/summary.h"
 #include "explore/explore_world.h"
 #include "fusion/integrate.h"
 #include "planning/integrate_planning.h"
@@ -69,7 +74,13 @@ struct RobotRun {
   double t_s = 0.0;  // this robot's time on the run clock (its Robot clock plus waiting)
   bool idle = false;
   double next_capture_s = 0.0;  // time-based capture (ModeParams::capture_hz): the next frame
-  double idle_s = 0.0;          // of t_s, with an empty queue
+  // Tracked poses: a tracker per mode (each mode's camera), the last frame's true and fused
+  // camera poses (the odometry's start and the tracker's prior's base).
+  // (Shared: RobotRun is copied when robots_ grows, and a tracker cannot be.)
+  std::map<int, std::shared_ptr<FrameTracker>> trackers;
+  bool tracking_started = false;  // after the start sweep
+  Pose3f last_true_T_W_C = Pose3f::Identity(), last_fused_T_W_C = Pose3f::Identity();
+  double idle_s = 0.0;  // of t_s, with an empty queue
   uint64_t frames = 0;
   RobotTrack track;
   std::vector<PlannerTask> views;
@@ -117,6 +128,10 @@ class Explorer {
   Status StepToView(RobotRun& r, QueuedTask& q);
   bool RouteTo(RobotRun& r, const QueuedTask& q);
   void Fail(RobotRun& r, const std::string& why);
+  // Tracked poses: where frame `frame` of r is fused, or nullopt when the tracker lost it.
+  Result<std::optional<Pose3f>> TrackFrame(RobotRun& r, const RenderOutput& frame,
+                                           const PinholeCamera& camera, const Pose3f& T_W_C,
+                                           float* residual_rms_m);
   void Bump(RobotRun& r, const Eigen::Vector2f& goal_W);
   // A drive the true floor refused on the way to q: a plugin path is left for the host's route,
   // the host's own route bumps and fails the task.
@@ -204,6 +219,20 @@ Status Explorer::Fuse(RobotRun& r, bool force) {
     out.depth = std::move(noisy).value();
     result_.timings.noise_ms += NowMs() - t0;
   }
+  Pose3f T_fuse = T_W_C;
+  float residual_rms_m = 0.f;
+  if (p_.poses == ExploreParams::Poses::kTracked) {
+    t0 = NowMs();
+    Result<std::optional<Pose3f>> tracked = TrackFrame(r, out, camera, T_W_C, &residual_rms_m);
+    result_.timings.track_ms += NowMs() - t0;
+    if (!tracked.ok()) return tracked.status();
+    if (!tracked->has_value()) {  // lost: not fused (a wrong pose would smear the map)
+      ++r.frames;
+      ++result_.frames_lost;
+      return Status::Ok();
+    }
+    T_fuse = **tracked;
+  }
   IntegrateParams ip;
   ip.min_depth_m = r.robot.mode_params().min_range_m;
   ip.max_depth_m = r.robot.mode_params().max_range_m;
@@ -212,14 +241,14 @@ Status Explorer::Fuse(RobotRun& r, bool force) {
   t0 = NowMs();
   Result<PlanningFrameStats> stats =
       IntegratePlanningFrame(out.depth, out.color, p_.fuse_labels ? &out.labels : nullptr, camera,
-                             T_W_C, ip, *volume_, map_);
+                             T_fuse, ip, *volume_, map_);
   if (!stats.ok()) return stats.status();
   result_.blocks_dropped += stats->integrate.blocks_refused;
   if (recon_) {  // the same frame into the finer volume, for the mesh alone
     IntegrateParams fine_ip = ip;
     fine_ip.weighting = p_.recon_weighting;
     Result<IntegrateStats> fine =
-        IntegrateFrame(out.depth, out.color, camera, T_W_C, fine_ip, *recon_);
+        IntegrateFrame(out.depth, out.color, camera, T_fuse, fine_ip, *recon_);
     if (!fine.ok()) return fine.status();
     result_.blocks_dropped += fine->blocks_refused;
   }
@@ -228,8 +257,44 @@ Status Explorer::Fuse(RobotRun& r, bool force) {
                   stats->integrate.touched_blocks.end());
   ++r.frames;
   ++result_.frames_fused;
-  result_.frames[r.index].push_back({r.t_s, T_W_C});
+  result_.frames[r.index].push_back({r.t_s, T_W_C, T_fuse, residual_rms_m});
   return Status::Ok();
+}
+
+Result<std::optional<Pose3f>> Explorer::TrackFrame(RobotRun& r, const RenderOutput& frame,
+                                                   const PinholeCamera& camera, const Pose3f& T_W_C,
+                                                   float* residual_rms_m) {
+  if (!r.tracking_started) {  // the start sweep anchors the map where the robot truly is
+    r.last_true_T_W_C = r.last_fused_T_W_C = T_W_C;
+    return std::optional<Pose3f>(T_W_C);
+  }
+  const int mode = int(r.robot.mode());
+  auto it = r.trackers.find(mode);
+  if (it == r.trackers.end()) {
+    try {
+      it = r.trackers.emplace(mode, std::make_shared<FrameTracker>(camera, p_.tracking)).first;
+    } catch (const std::invalid_argument& e) {
+      return InvalidArgument(std::string("tracked poses: ") + e.what());
+    }
+  }
+  // The odometry's motion since the last frame, noisy, from where that frame was fused.
+  const Pose3f delta = r.last_true_T_W_C.inverse() * T_W_C;
+  const Pose3f prior =
+      r.last_fused_T_W_C *
+      NoisyOdometry(delta, p_.odometry, p_.seed, (uint64_t(r.index) << 32) | uint64_t(r.frames));
+  // Against the planning map, also beside a finer volume: at 320 x 240 a 2 cm volume is too
+  // sparse a model (a fifth of the pixels associate; every frame after the sweep was lost).
+  Result<TrackingResult> t = it->second->Track(frame.depth, frame.color, *volume_, prior);
+  if (!t.ok()) return t.status();
+  r.last_true_T_W_C = T_W_C;
+  *residual_rms_m = t->residual_rms_m;
+  if (!t->ok) {  // dead reckoning carries on from the prior
+    r.last_fused_T_W_C = prior;
+    return std::optional<Pose3f>();
+  }
+  r.last_fused_T_W_C = t->T_W_C;
+  it->second->Accept(t->T_W_C);
+  return std::optional<Pose3f>(t->T_W_C);
 }
 
 void Explorer::Sample(RobotRun& r, RobotStatus status) {
@@ -880,6 +945,7 @@ Result<ExploreResult> Explorer::Run(const std::vector<Eigen::Vector2f>& starts) 
   for (RobotRun& r : robots_) {
     Sample(r, RobotStatus::kBusy);
     VOXPLAN_RETURN_IF_ERROR(Sweep(r));
+    r.tracking_started = true;  // the sweep's frames anchor the map; tracked poses from here
     t_s_ = std::max(t_s_, r.t_s);
   }
   for (RobotRun& r : robots_) r.t_s = t_s_;  // the slower sweeps set the start of planning
@@ -984,6 +1050,10 @@ Status ExploreParams::Validate() const {
       !(progress_interval_s > 0.0))
     return InvalidArgument("explore: output intervals must be > 0");
   if (!(route_margin_m >= 0.f)) return InvalidArgument("explore: route_margin_m must be >= 0");
+  const auto noise_ok = [](float v) { return v >= 0.f && v <= 1.f; };
+  if (!noise_ok(odometry.translation_per_m) || !noise_ok(odometry.rotation_per_rad) ||
+      !noise_ok(odometry.rotation_per_m))
+    return InvalidArgument("explore: odometry noise must be in [0, 1] per metre or radian");
   return robot.Validate();
 }
 
@@ -1081,6 +1151,25 @@ ObservedRaster ObservedFromFloor(const FloorMap& floor) {
   out.cells.resize(floor.cells().size());
   for (size_t i = 0; i < out.cells.size(); ++i)
     out.cells[i] = floor.cells()[i] == FloorCell::kUnknown ? kUnknownCell : 1;
+  return out;
+}
+
+TrackedPoseSummary SummarizeTrackedPoses(const std::vector<std::vector<ExploreFrame>>& frames) {
+  TrackedPoseSummary out;
+  std::vector<double> residuals;
+  double squared = 0.0;
+  for (const std::vector<ExploreFrame>& robot : frames) {
+    for (size_t i = 0; i < robot.size(); ++i) {
+      const ExploreFrame& f = robot[i];
+      squared += (f.T_W_C_fused.translation() - f.T_W_C.translation()).squaredNorm();
+      ++out.frames;
+      if (f.residual_rms_m > 0.f) residuals.push_back(f.residual_rms_m);  // tracked, not anchored
+    }
+  }
+  const TimingSummary r = Summarize(residuals);
+  out.residual_mean_m = r.mean;
+  out.residual_p90_m = r.p90;
+  out.ate_rms_m = out.frames > 0 ? std::sqrt(squared / double(out.frames)) : 0.0;
   return out;
 }
 

@@ -38,11 +38,13 @@
 #include "core/volume.h"
 #include "eval/eval_run.h"
 #include "fusion/integrate.h"
+#include "fusion/tracking.h"
 #include "planning/floor_map.h"
 #include "planning/planning_map.h"
 #include "plugins/host/plugin_host.h"
 #include "sim/detector.h"
 #include "sim/floor_plan.h"
+#include "sim/odometry.h"
 #include "sim/robot.h"
 #include "sim/world.h"
 
@@ -60,7 +62,22 @@ struct ExploreParams {
   // How the reconstruction volume weighs a frame's depth: 1/z² (Voxblox's default, which Guo 2022
   // fused with) lets a close scan outweigh far, noisier ones; the planning map stays constant.
   Weighting recon_weighting = Weighting::kConstant;
-  bool noise = true;        // Kinect noise on the rendered depth
+  bool noise = true;  // Kinect noise on the rendered depth
+  // Where frames are fused: at the true camera pose, or (kTracked, Xu 2017's registration) at
+  // the pose FrameTracker estimates against the map from a noisy odometry prior, frames it loses
+  // skipped. Each robot's start sweep anchors its map at the truth (a frame must overlap the map
+  // to be tracked, and the sweep's pitch rows barely overlap); robots and planners still know
+  // their true poses (only the maps see the estimates).
+  enum class Poses { kTruth, kTracked };
+  Poses poses = Poses::kTruth;
+  OdometryNoiseParams odometry;
+  // An exploring camera sees new space in most frames: a tenth of its pixels on the model is
+  // enough to register it (the handheld default, a quarter, lost most frames past a doorway).
+  TrackingParams tracking = [] {
+    TrackingParams t;
+    t.min_inlier_ratio = 0.1f;
+    return t;
+  }();
   bool fuse_labels = true;  // instance labels into the object map
   // How the labels are detected before they are fused (sim/detector.h): noisy by default.
   DetectorParams detector;
@@ -140,13 +157,15 @@ struct PlanCallRecord {
 
 struct ExploreTimings {  // wall milliseconds, summed over the run
   double render_ms = 0.0, detect_ms = 0.0, noise_ms = 0.0, fuse_ms = 0.0, floor_ms = 0.0,
-         plan_ms = 0.0, series_ms = 0.0, total_ms = 0.0;
+         plan_ms = 0.0, series_ms = 0.0, total_ms = 0.0, track_ms = 0.0;
 };
 
 // A frame the loop fused: when and from where.
 struct ExploreFrame {
   double t_s = 0.0;
   Pose3f T_W_C = Pose3f::Identity();
+  Pose3f T_W_C_fused = Pose3f::Identity();  // where it was fused (the estimate when tracked)
+  float residual_rms_m = 0.f;               // the tracker's, when tracked
 };
 
 struct ExploreResult {
@@ -154,6 +173,7 @@ struct ExploreResult {
   std::string done_reason;  // "planner", "no_tasks" or "" (time limit)
   double time_s = 0.0;
   size_t frames_fused = 0;
+  size_t frames_lost = 0;       // with tracked poses: frames the tracker lost, not fused
   size_t objects_detected = 0;  // summed over frames, after the detector's noise
   size_t failed_tasks = 0;
   size_t rejected_tasks = 0;
@@ -186,6 +206,15 @@ Result<ExploreResult> RunExplore(const World& world, const FloorPlan& plan,
                                  const ExploreParams& params,
                                  const std::function<double(const TsdfVolume&)>& completeness_probe,
                                  const ExploreProgressFn& progress = {});
+
+// Tracking quality over the frames of a run fused at tracked poses (the start sweeps' frames,
+// anchored at the truth, have no residual and no error): the tracker's point-to-plane residual
+// (mean and p90) and the absolute trajectory error, the RMS of |fused − true| camera positions.
+struct TrackedPoseSummary {
+  double residual_mean_m = 0.0, residual_p90_m = 0.0, ate_rms_m = 0.0;
+  size_t frames = 0;
+};
+TrackedPoseSummary SummarizeTrackedPoses(const std::vector<std::vector<ExploreFrame>>& frames);
 
 // A cheap completeness for the time series: the share of `samples_W` (ground-truth surface
 // points) where the interpolated TSDF (all 8 voxels observed) is within threshold_m of zero.

@@ -81,6 +81,15 @@ json MetricsObject(const ExploreRunParams& params, const ExploreRunReport& repor
   // Only with the option, so runs without it keep their bytes: what the mesh was fused at.
   if (params.explore.recon_voxel_size_m > 0.f)
     m["mesh_voxel_size_m"] = RoundTo(params.explore.recon_voxel_size_m, 4);
+  // Only with tracked poses, so runs at the true poses keep their bytes.
+  if (params.explore.poses == ExploreParams::Poses::kTracked) {
+    const TrackedPoseSummary t = SummarizeTrackedPoses(r.frames);
+    m["poses"] = "tracked";
+    m["frames_lost"] = r.frames_lost;
+    m["registration_rms_m"] = RoundTo(t.residual_mean_m, 5);
+    m["registration_rms_p90_m"] = RoundTo(t.residual_p90_m, 5);
+    m["ate_rms_m"] = RoundTo(t.ate_rms_m, 5);
+  }
   // Per object (Guo 2022 eq. 6 and 7), null without objects; rows in objects.csv.
   const std::optional<ObjectsEvalResult>& objects = report.objects;
   m["o_comp_2cm"] = objects ? json(RoundTo(objects->o_comp, 4)) : json();

@@ -521,6 +521,11 @@ Pose3f FrameTracker::Predict() const {
 
 Result<TrackingResult> FrameTracker::Track(const DepthImage& depth, const ColorImage& color,
                                            const TsdfVolume& volume) {
+  return Track(depth, color, volume, Predict());
+}
+
+Result<TrackingResult> FrameTracker::Track(const DepthImage& depth, const ColorImage& color,
+                                           const TsdfVolume& volume, const Pose3f& T_W_C_pred) {
   if (depth.width != camera_.width || depth.height != camera_.height)
     return InvalidArgument("Track: depth is " + std::to_string(depth.width) + "x" +
                            std::to_string(depth.height) + ", camera is " +
@@ -529,7 +534,6 @@ Result<TrackingResult> FrameTracker::Track(const DepthImage& depth, const ColorI
     return InvalidArgument("Track: colour and depth sizes differ");
   const Stopwatch total_clock;
   TrackingResult result;
-  const Pose3f T_W_C_pred = Predict();
   result.T_W_C = T_W_C_pred;
   const bool photometric = params_.photometric_weight > 0.f && !color.empty();
 

@@ -84,6 +84,9 @@ class FrameTracker {
   void Reset(const Pose3f& T_W_C);
   Result<TrackingResult> Track(const DepthImage& depth, const ColorImage& color,
                                const TsdfVolume& volume);
+  // The same from a prediction the caller has (a robot's odometry) instead of Predict()'s.
+  Result<TrackingResult> Track(const DepthImage& depth, const ColorImage& color,
+                               const TsdfVolume& volume, const Pose3f& T_W_C_pred);
   // Records a tracked pose (successful frames) for the next prediction.
   void Accept(const Pose3f& T_W_C);
   Pose3f Predict() const;

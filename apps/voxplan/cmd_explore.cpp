@@ -54,6 +54,8 @@ struct ExploreOptions {
   bool no_noise = false;
   bool no_labels = false;
   bool no_detector_noise = false;
+  std::string poses = "truth";        // --poses
+  std::vector<float> odometry_noise;  // --odometry-noise T,R: per metre, per radian
   bool no_color = false;
   bool no_clear = false;
   double fuse_step_m = 0.25, fuse_step_deg = 15.0;
@@ -189,6 +191,12 @@ Result<ExploreRunParams> RunParams(const ExploreOptions& o, std::vector<Eigen::V
   params.noise = !o.no_noise;
   params.fuse_labels = !o.no_labels;
   params.detector.noise = !o.no_detector_noise;
+  params.poses =
+      o.poses == "tracked" ? ExploreParams::Poses::kTracked : ExploreParams::Poses::kTruth;
+  if (o.odometry_noise.size() == 2) {
+    params.odometry.translation_per_m = o.odometry_noise[0];
+    params.odometry.rotation_per_rad = o.odometry_noise[1];
+  }
   params.fuse_color = !o.no_color;
   params.clear_beyond_range = !o.no_clear;
   params.trigger = {float(o.fuse_step_m), float(o.fuse_step_deg)};
@@ -332,6 +340,18 @@ Command AddExploreCommand(CLI::App& app) {
   sub->add_flag("--no-detector-noise", o->no_detector_noise,
                 "Fuse the simulator's instance labels as they are (by default a detector model "
                 "drops, erodes, merges and size-filters them per frame: sim/detector.h)");
+  sub->add_option("--poses", o->poses,
+                  "Where frames are fused: truth (the true camera poses) or tracked (poses the "
+                  "frame-to-model tracker estimates from a noisy odometry prior; lost frames are "
+                  "skipped; registration residual, ATE and frames lost go in metrics.json)")
+      ->check(CLI::IsMember({"truth", "tracked"}))
+      ->capture_default_str();
+  sub->add_option("--odometry-noise", o->odometry_noise,
+                  "With --poses tracked: odometry noise, 1 sigma per axis, as T,R: metres per "
+                  "metre moved and radians per radian turned (default 0.02,0.01)")
+      ->delimiter(',')
+      ->expected(2)
+      ->check(CLI::Range(0.0, 1.0));
   sub->add_flag("--no-color", o->no_color,
                 "Render and fuse no colour (a grey mesh.ply; the metrics do not change)");
   positive("--planning-interval", run.explore.planning_interval_s,

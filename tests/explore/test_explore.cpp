@@ -442,6 +442,56 @@ TEST(Explore, RequestedCallsComeAtTheFirstStepAfterTheirTime) {
   for (const PlanCallRecord& c : refused->plan_calls) EXPECT_NE(c.event, PlanEvent::kWakeup);
 }
 
+TEST(Explore, TrackedPosesFuseAtTheEstimateAndCountLostFrames) {
+  // --poses tracked: the start sweep is fused at the truth, every later frame at the tracker's
+  // estimate (close to the truth, not equal) or not at all (lost, counted); at the truth every
+  // frame is fused where it was taken.
+  const Scene& s = SmallApartment();
+  // The loop's own map and image size (FastParams' 10 cm and 160 x 120 are too coarse to track).
+  ExploreParams params = FastParams();
+  params.voxel_size_m = 0.05f;
+  params.image_width = 320;
+  params.image_height = 240;
+  params.max_time_s = 60.0;
+  params.noise = true;
+  const std::vector<Eigen::Vector2f> starts =
+      ChooseStarts(s.plan, s.world.rooms, 1, params.robot.radius_m).value();
+  auto run = [&](ExploreParams::Poses poses) {
+    params.poses = poses;
+    std::unique_ptr<LoadedPlanner> planner = Greedy();
+    EXPECT_TRUE(planner);
+    Result<ExploreResult> r = RunExplore(s.world, s.plan, starts, *planner, params, {});
+    EXPECT_TRUE(r.ok()) << r.status().message();
+    return std::move(r).value();
+  };
+  const ExploreResult truth = run(ExploreParams::Poses::kTruth);
+  for (const ExploreFrame& f : truth.frames[0]) EXPECT_TRUE(f.T_W_C_fused.isApprox(f.T_W_C, 0.f));
+  EXPECT_EQ(truth.frames_lost, 0u);
+
+  const ExploreResult tracked = run(ExploreParams::Poses::kTracked);
+  size_t anchored = 0, estimated = 0;
+  for (const ExploreFrame& f : tracked.frames[0]) {
+    const float error_m = (f.T_W_C_fused.translation() - f.T_W_C.translation()).norm();
+    if (f.residual_rms_m == 0.f) {
+      EXPECT_EQ(error_m, 0.f);  // the sweep
+      ++anchored;
+    } else {
+      EXPECT_LT(error_m, 0.25f);  // odometry at 2 % and ICP against a 5 cm map
+      EXPECT_LT(f.residual_rms_m, params.tracking.max_residual_rms_m + 1e-6f);
+      ++estimated;
+    }
+  }
+  EXPECT_GE(anchored, 12u);  // a full turn of the sweep at least
+  EXPECT_GE(estimated, 10u);
+  EXPECT_LT(tracked.frames_lost, estimated);  // most frames track
+  const TrackedPoseSummary summary = SummarizeTrackedPoses(tracked.frames);
+  EXPECT_EQ(summary.frames, tracked.frames_fused);
+  EXPECT_GT(summary.ate_rms_m, 0.0);
+  EXPECT_LT(summary.ate_rms_m, 0.15);
+  EXPECT_GT(summary.residual_mean_m, 0.0);
+  EXPECT_LE(summary.residual_mean_m, summary.residual_p90_m + 1e-12);
+}
+
 TEST(Explore, PlannersSeeTheExplorerCamera) {
   const Scene& s = SmallApartment();
   ExploreParams params = FastParams();
