@@ -318,6 +318,21 @@ LivingBlock AddLivingBlock(const Bands& bands, const RoomProgram& program, Rng& 
   return block;
 }
 
+// The entrance: a closed door slab in the west exterior wall, opening [o0_u, o0_u + width_u)
+// along it, into `room`.
+void AddEntrance(GridLayout* layout, int west_wall, int room, int o0_u, int width_u) {
+  GridDoor door;
+  door.along_x = false;
+  door.o0 = o0_u;
+  door.o1 = o0_u + width_u;
+  door.t0 = 0;
+  door.t1 = kExteriorWallU;
+  door.closed = true;
+  door.room_a = room;
+  door.floor_room = room;
+  layout->walls[west_wall].doors.push_back(AddDoor(layout, door));
+}
+
 // The corridor's opening into the living block, the strip kitchen's second door and the
 // entrance.
 void AddCorridorDoors(const Bands& bands, int corridor, int kitchen_room, const LivingBlock& block,
@@ -356,19 +371,10 @@ void AddCorridorDoors(const Bands& bands, int corridor, int kitchen_room, const 
     layout->walls[walls.separator].doors.push_back(AddDoor(layout, door));
   }
   // The entrance: a closed door in the west wall at the corridor.
-  {
-    GridDoor door;
-    door.along_x = false;
-    const int door_width_u = std::min(20, bands.corridor_width_u - 2);
-    door.o0 = rng.Int(bands.corridor_y0_u + 1, bands.corridor_y1_u - 1 - door_width_u);
-    door.o1 = door.o0 + door_width_u;
-    door.t0 = 0;
-    door.t1 = kExteriorWallU;
-    door.closed = true;
-    door.room_a = corridor;
-    door.floor_room = corridor;
-    layout->walls[walls.west].doors.push_back(AddDoor(layout, door));
-  }
+  const int door_width_u = std::min(20, bands.corridor_width_u - 2);
+  AddEntrance(layout, walls.west, corridor,
+              rng.Int(bands.corridor_y0_u + 1, bands.corridor_y1_u - 1 - door_width_u),
+              door_width_u);
 }
 
 // Names: bedroom_1, bedroom_2, ... where a type repeats.
@@ -405,18 +411,11 @@ GridLayout MakeRoomLayout(Rng& rng) {
   const int room =
       AddRoom(&layout, kTypes[rng.Int(0, 3)],
               {kExteriorWallU, kExteriorWallU, width_u - kExteriorWallU, depth_u - kExteriorWallU});
-  GridDoor door;
-  door.along_x = false;
   const int door_width_u = 18;
   const int interior_u = depth_u - 2 * kExteriorWallU;
-  door.o0 = kExteriorWallU + rng.Int(4, std::max(4, interior_u - 4 - door_width_u));
-  door.o1 = door.o0 + door_width_u;
-  door.t0 = 0;
-  door.t1 = kExteriorWallU;
-  door.closed = true;
-  door.room_a = room;
-  door.floor_room = room;
-  layout.walls[west].doors.push_back(AddDoor(&layout, door));
+  AddEntrance(&layout, west, room,
+              kExteriorWallU + rng.Int(4, std::max(4, interior_u - 4 - door_width_u)),
+              door_width_u);
   NameRooms(&layout);
   return layout;
 }
