@@ -143,6 +143,19 @@ RobotParams Guo2022RobotParams() {
   return p;
 }
 
+RobotParams Xu2017RobotParams() {
+  RobotParams p;
+  ModeParams& e = p.explorer;
+  e.max_speed_mps = 0.3f;  // X L304
+  e.horizontal_fov_deg = 58.f;
+  e.min_range_m = 0.5f;  // a Kinect v1's
+  e.max_range_m = 4.f;
+  e.capture_hz = 5.f;
+  // The camera joints at a_m = 40°/s (X L306, whose second "v_m" is a typo for it).
+  p.camera_yaw_rate_radps = p.camera_pitch_rate_radps = 0.6981317f;
+  return p;
+}
+
 Result<RobotParams> ParseRobotConfig(const std::string& json_text, const RobotParams& base,
                                      const std::string& source) {
   json j;
@@ -198,9 +211,15 @@ Status ApplyExploreProfile(const std::string& name, ExploreParams* params) {
     params->detector = DetectorParams{};
     return Status::Ok();
   }
+  if (name == "xu2017") {
+    params->robot = Xu2017RobotParams();
+    params->recon_voxel_size_m = 0.02f;
+    params->step_s = 0.1;  // the planner's 0.4 s sub-steps land within a tenth of a second
+    return Status::Ok();
+  }
   return NotFound("unknown profile '" + name + "' (" + ExploreProfileNames() + ")");
 }
 
-const char* ExploreProfileNames() { return "guo2022"; }
+const char* ExploreProfileNames() { return "guo2022, xu2017"; }
 
 }  // namespace voxplan

@@ -134,8 +134,17 @@ def true_incompleteness(objects_csv):
 
 
 def plan_call_ms(plan_calls):
+    """Wall ms of every plan call, and of the calls that planned: those that generated tasks
+    (their diagnostics name gen_exp_ms), not the ones the flow answered at once."""
+    every, planned = [], []
     with open(plan_calls, newline="") as f:
-        return [float(r["elapsed_ms"]) for r in csv.DictReader(f) if r.get("elapsed_ms")]
+        for r in csv.DictReader(f):
+            if not r.get("elapsed_ms"):
+                continue
+            every.append(float(r["elapsed_ms"]))
+            if "gen_exp_ms=" in r.get("diagnostics", ""):
+                planned.append(float(r["elapsed_ms"]))
+    return every, planned
 
 
 def load(out):
@@ -281,16 +290,21 @@ class Summary:
     def planning(self, variant="taskflow"):
         # Per plan call, pooled over the variant's runs at the team size (plan_calls.csv),
         # beside the median of each run's own median (metrics.json).
-        calls, run_medians = [], []
+        calls, planned, run_medians = [], [], []
         for run in self.team_runs(variant):
             if (run["dir"] / "plan_calls.csv").exists():
-                calls += plan_call_ms(run["dir"] / "plan_calls.csv")
+                every, some = plan_call_ms(run["dir"] / "plan_calls.csv")
+                calls += every
+                planned += some
             if num(run["m"].get("plan_ms_median")):
                 run_medians.append(run["m"]["plan_ms_median"])
-        if not calls:
+        if not planned:
             return None
-        return {"variant": variant, "calls": len(calls), "call_ms_median": statistics.median(calls),
-                "call_ms_p90": percentile(calls, 0.9), "call_ms_max": max(calls),
+        # The targets judge the calls that planned; most calls are the flow's "nothing to do"
+        # (a robot still busy), whose microseconds would make any median look fast.
+        return {"variant": variant, "calls": len(planned), "call_ms_median": statistics.median(planned),
+                "call_ms_p90": percentile(planned, 0.9), "call_ms_max": max(planned),
+                "all_calls": len(calls), "all_call_ms_median": statistics.median(calls),
                 "run_median_ms_median": statistics.median(run_medians) if run_medians else None}
 
 
@@ -382,7 +396,8 @@ def targets(s, calib, plan):
              "pairs": 0, "note": "no taskflow plan calls"}
         if plan:
             t.update(value=plan[key] / 1000, pairs=plan["calls"], status="met" if plan[key] <= limit else "not met",
-                     note=f"seconds, pooled over {plan['calls']} calls at {s.team} robots")
+                     note=f"seconds, over the {plan['calls']} calls that planned (of {plan['all_calls']}) "
+                          f"at {s.team} robots; wall time, machine load included")
         out.append(t)
     return out
 
@@ -440,8 +455,10 @@ def render(s, med, comps, by_group, tgts, calib, plan):
                  f"{fmt(calib['rho_pooled'])} over {calib['objects']} objects in {calib['runs']} run(s); "
                  f"median per run {fmt(calib['rho_per_run_median'])}.")
     if plan:
-        parts.append(f"\nPlanning (taskflow, {plan['calls']} calls): median {plan['call_ms_median']:.1f} ms, "
-                     f"p90 {plan['call_ms_p90']:.1f} ms, max {plan['call_ms_max']:.1f} ms per call.")
+        parts.append(f"\nPlanning (taskflow, {plan['calls']} calls that planned, of {plan['all_calls']}): "
+                     f"median {plan['call_ms_median']:.1f} ms, p90 {plan['call_ms_p90']:.1f} ms, "
+                     f"max {plan['call_ms_max']:.1f} ms per call; over every call the median is "
+                     f"{plan['all_call_ms_median']:.1f} ms.")
     return "\n".join(parts) + "\n"
 
 

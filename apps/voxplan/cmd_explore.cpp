@@ -191,8 +191,9 @@ Result<ExploreRunParams> RunParams(const ExploreOptions& o, std::vector<Eigen::V
   params.noise = !o.no_noise;
   params.fuse_labels = !o.no_labels;
   params.detector.noise = !o.no_detector_noise;
-  params.poses =
-      o.poses == "tracked" ? ExploreParams::Poses::kTracked : ExploreParams::Poses::kTruth;
+  if (o.profile.empty() || Given(o, "--poses"))
+    params.poses =
+        o.poses == "tracked" ? ExploreParams::Poses::kTracked : ExploreParams::Poses::kTruth;
   if (o.odometry_noise.size() == 2) {
     params.odometry.translation_per_m = o.odometry_noise[0];
     params.odometry.rotation_per_rad = o.odometry_noise[1];
@@ -298,7 +299,10 @@ Command AddExploreCommand(CLI::App& app) {
                       ExploreProfileNames() +
                       "): guo2022 = Guo 2022's robot (head explorer, arm reconstructor, 2 Hz "
                       "capture, 2 s mode switch; explore/robot_config.h), a 2 cm reconstruction "
-                      "volume, detector noise on. Options given beside it win");
+                      "volume, detector noise on; xu2017 = Xu 2017's robot (0.3 m/s, a Kinect's "
+                      "58 deg and 0.5-4 m, 5 Hz capture, camera joints at 40 deg/s), a 2 cm "
+                      "reconstruction volume, a 0.1 s loop step. Options given "
+                      "beside it win");
   sub->add_option("--robot-config", o->robot_config,
                   "JSON file of the robot and both modes (speeds, fields of view, ranges, "
                   "mounts, capture, switch time; explore/robot_config.h), over --profile's; "

@@ -1,5 +1,5 @@
 // The robot file (explore/robot_config.h): round trips, partial files over a base, refusals
-// naming the key, and the guo2022 profile.
+// naming the key, and the guo2022 and xu2017 profiles.
 #include <gtest/gtest.h>
 
 #include <filesystem>
@@ -66,6 +66,18 @@ TEST(RobotConfig, TheGuoProfileSetsTheRobotTheFineVolumeAndTheDetector) {
   EXPECT_EQ(params.robot.reconstructor.switch_s, 2.f);
   EXPECT_TRUE(params.Validate().ok());
   EXPECT_EQ(ApplyExploreProfile("dong2019", &params).code(), StatusCode::kNotFound);
+}
+
+TEST(RobotConfig, TheXuProfileSetsTheRobotTheFineVolumeAndTheStep) {
+  ExploreParams params;
+  ASSERT_TRUE(ApplyExploreProfile("xu2017", &params).ok());
+  EXPECT_EQ(params.robot.explorer.max_speed_mps, 0.3f);
+  EXPECT_EQ(params.robot.explorer.capture_hz, 5.f);
+  EXPECT_NEAR(params.robot.camera_yaw_rate_radps, 40.0 * M_PI / 180.0, 1e-6);
+  EXPECT_EQ(params.recon_voxel_size_m, 0.02f);
+  EXPECT_EQ(params.poses, ExploreParams::Poses::kTruth);  // tracked is asked for apart
+  EXPECT_EQ(params.step_s, 0.1);
+  EXPECT_TRUE(params.Validate().ok());
 }
 
 }  // namespace
