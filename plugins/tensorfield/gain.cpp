@@ -1,0 +1,94 @@
+// The 2-D view gain: ray sectors over the floor raster, best field-of-view window.
+#include "plugins/tensorfield/gain.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include "plugins/tensorfield/frames.h"
+
+namespace voxplan::tensorfield {
+
+ViewGain::ViewGain(const omt::RasterGeometry& geometry, std::vector<std::uint8_t> codes,
+                   const GainParams& params)
+    : geometry_(geometry), params_(params) {
+  params_.rays = std::max(8, params_.rays);
+  unseen_.resize(codes.size());
+  for (std::size_t i = 0; i < codes.size(); ++i)
+    unseen_[i] = codes[i] == kFloorObstacle                                ? 2
+                 : codes[i] == kFloorUnknown || codes[i] == kFloorFrontier ? 1
+                                                                           : 0;
+  const double dtheta = 2.0 * omt::kPi / params_.rays;
+  window_ = std::clamp(static_cast<int>(std::lround(params_.fov_rad / dtheta)), 1, params_.rays);
+  const double r = params_.range_m, n = std::min(params_.near_m, r);
+  fan_area_m2_ = std::max(1e-9, 0.5 * window_ * dtheta * (r * r - n * n));
+}
+
+std::vector<double> ViewGain::Sectors(const Eigen::Vector2d& p_m) const {
+  const int rays = params_.rays;
+  std::vector<double> out(static_cast<std::size_t>(rays), 0.0);
+  const double dtheta = 2.0 * omt::kPi / rays;
+  const double step = geometry_.resolution_m;
+  for (int k = 0; k < rays; ++k) {
+    const double a = dtheta * k;
+    const Eigen::Vector2d d(std::cos(a), std::sin(a));
+    double area = 0.0;
+    for (double t = 0.5 * step; t <= params_.range_m; t += step) {
+      const int c = geometry_.IndexOf(p_m + t * d);
+      if (c < 0) break;
+      const std::uint8_t u = unseen_[static_cast<std::size_t>(c)];
+      if (u == 2) break;
+      if (u == 1 && t >= params_.near_m) area += t * step * dtheta;
+    }
+    out[static_cast<std::size_t>(k)] = area;
+  }
+  return out;
+}
+
+ViewChoice ViewGain::Best(const Eigen::Vector2d& p_m, double centre_rad,
+                          double half_window_rad) const {
+  const std::vector<double> s = Sectors(p_m);
+  const int rays = params_.rays;
+  const double dtheta = 2.0 * omt::kPi / rays;
+  // Window starting at ray k covers rays k .. k + window - 1; its axis is their middle.
+  double sum = 0.0;
+  for (int j = 0; j < window_; ++j) sum += s[static_cast<std::size_t>(j % rays)];
+  ViewChoice best;
+  best.yaw_rad = centre_rad;
+  best.gain = -1.0;
+  for (int k = 0; k < rays; ++k) {
+    const double axis = dtheta * (k + 0.5 * (window_ - 1));
+    if (half_window_rad >= omt::kPi ||
+        std::abs(omt::WrapAngle(axis - centre_rad)) <= half_window_rad + 1e-9) {
+      if (sum > best.gain + 1e-12) {
+        best.gain = sum;
+        best.yaw_rad = omt::WrapAngle(axis);
+      }
+    }
+    sum += s[static_cast<std::size_t>((k + window_) % rays)] - s[static_cast<std::size_t>(k)];
+  }
+  if (best.gain < 0.0) {  // no window axis inside the range: look along its centre
+    best.yaw_rad = centre_rad;
+    best.gain = GainAt(p_m, centre_rad) * fan_area_m2_;
+  }
+  best.gain = std::clamp(best.gain / fan_area_m2_, 0.0, 1.0);
+  return best;
+}
+
+double ViewGain::PointGain(const Eigen::Vector2d& p_m) const {
+  return Best(p_m, 0.0, omt::kPi).gain;
+}
+
+double ViewGain::GainAt(const Eigen::Vector2d& p_m, double yaw_rad) const {
+  const std::vector<double> s = Sectors(p_m);
+  const int rays = params_.rays;
+  const double dtheta = 2.0 * omt::kPi / rays;
+  double a = std::fmod(yaw_rad, 2.0 * omt::kPi);
+  if (a < 0.0) a += 2.0 * omt::kPi;
+  const int first = static_cast<int>(std::lround(a / dtheta - 0.5 * (window_ - 1)));
+  double sum = 0.0;
+  for (int j = 0; j < window_; ++j)
+    sum += s[static_cast<std::size_t>(((first + j) % rays + rays) % rays)];
+  return std::clamp(sum / fan_area_m2_, 0.0, 1.0);
+}
+
+}  // namespace voxplan::tensorfield

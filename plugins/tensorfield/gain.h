@@ -1,0 +1,54 @@
+// The tensorfield planner's view gain [ours]: X's V(q, α) and I(e, p) are in an unavailable
+// appendix (X L220, L270; planner-wave.md §2.4). A 2-D stand-in on the floor raster: the unseen
+// floor (unknown and frontier cells) a camera at p sees within its range and field of view, rays
+// stopping at obstacle cells and passing through unknown ones, as a share of the fan's area.
+// Surface uncertainty (the design's second term) is not modelled. Plain data; deterministic.
+#pragma once
+
+#include <Eigen/Core>
+#include <cstdint>
+#include <vector>
+
+#include "plugins/omt/algorithms/types.h"
+
+namespace voxplan::tensorfield {
+
+struct GainParams {
+  double near_m = 0.3;   // floor nearer than this is not counted (the footprint; min range)
+  double range_m = 5.0;  // the camera's depth range
+  double fov_rad = 1.5707963;
+  int rays = 72;  // over 2π
+};
+
+struct ViewChoice {
+  double yaw_rad = 0.0;  // world yaw of the view's axis
+  double gain = 0.0;     // unseen area in the fan / the fan's area, in [0, 1]
+};
+
+class ViewGain {
+ public:
+  // codes: one FloorCode (frames.h) per cell of geometry (the planner passes settled cells as
+  // free: they count as seen). Rays march at the raster's resolution.
+  ViewGain(const omt::RasterGeometry& geometry, std::vector<std::uint8_t> codes,
+           const GainParams& params);
+
+  // Unseen area (m²) of each ray's sector around p, ray k at angle 2πk / rays.
+  std::vector<double> Sectors(const Eigen::Vector2d& p_m) const;
+  // The best view at p whose axis lies within half_window_rad of centre_rad (≥ π: any).
+  ViewChoice Best(const Eigen::Vector2d& p_m, double centre_rad, double half_window_rad) const;
+  // The best view at p in any direction (the I(e, p) of an edge point).
+  double PointGain(const Eigen::Vector2d& p_m) const;
+  // The view along yaw_rad exactly.
+  double GainAt(const Eigen::Vector2d& p_m, double yaw_rad) const;
+
+  const GainParams& params() const { return params_; }
+
+ private:
+  omt::RasterGeometry geometry_;
+  std::vector<std::uint8_t> unseen_;  // 1 unknown or frontier, 2 obstacle, 0 free
+  GainParams params_;
+  int window_ = 1;  // rays in one field of view
+  double fan_area_m2_ = 1.0;
+};
+
+}  // namespace voxplan::tensorfield

@@ -1,0 +1,456 @@
+// One robot's tensorfield plan step: key frames and sub-steps, advection, wedge and trisector
+// handling, routing, the frontier fallback and termination (camera: planner_camera.cpp).
+#include "plugins/tensorfield/planner.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <span>
+
+#include "plugins/omt/algorithms/raster_ops.h"
+#include "plugins/tensorfield/gain.h"
+
+namespace voxplan::tensorfield {
+namespace {
+
+double NowMs() {
+  return std::chrono::duration<double, std::milli>(
+             std::chrono::steady_clock::now().time_since_epoch())
+      .count();
+}
+
+double PolylineLength(std::span<const Eigen::Vector2d> line) {
+  double s = 0.0;
+  for (std::size_t i = 1; i < line.size(); ++i) s += (line[i] - line[i - 1]).norm();
+  return s;
+}
+
+// Settled frontier goals: cells this close to a goal the robot reached.
+constexpr double kSettleRadiusM = 0.6;
+// Fallback targets: traversable cells this close to an unsettled frontier cell.
+constexpr double kApproachM = 0.4;
+// A route is finished when less than this of it is left.
+constexpr double kRouteDoneM = 0.15;
+// A degenerate point the robot has just routed from is not routed from again for this long.
+constexpr double kBranchHoldS = 20.0;
+
+}  // namespace
+
+bool RobotPlanner::Traversable(const Eigen::Vector2d& p, double radius_m) const {
+  const int c = window_.geometry.IndexOf(p);
+  if (c < 0) return false;
+  const std::uint8_t code = window_.codes[static_cast<std::size_t>(c)];
+  return (code == kFloorFree || code == kFloorFrontier) && window_.clearance.At(c) >= radius_m;
+}
+
+std::vector<Eigen::Vector2d> RobotPlanner::TraversablePrefix(
+    const std::vector<Eigen::Vector2d>& line, double radius_m) const {
+  std::vector<Eigen::Vector2d> out;
+  for (std::size_t i = 0; i < line.size(); ++i) {
+    // Check the segment into point i at half-cell steps.
+    if (i > 0) {
+      const Eigen::Vector2d a = line[i - 1], b = line[i];
+      const int steps = std::max(
+          1, static_cast<int>(std::ceil((b - a).norm() / (0.5 * window_.geometry.resolution_m))));
+      bool ok = true;
+      for (int k = 1; k <= steps && ok; ++k)
+        ok = Traversable(a + (b - a) * (double(k) / steps), radius_m);
+      if (!ok) break;
+    }
+    out.push_back(line[i]);
+  }
+  return out;
+}
+
+RobotPlanner::Key RobotPlanner::KeyOf(const omt::RasterGeometry& g, int cell) const {
+  const Eigen::Vector2d c = g.Center(cell) / g.resolution_m;
+  return {static_cast<long>(std::floor(c.x())), static_cast<long>(std::floor(c.y()))};
+}
+
+bool RobotPlanner::Settled(const FloorInput& floor, int cell) const {
+  return !settled_.empty() && settled_.count(KeyOf(floor.geometry, cell)) > 0;
+}
+
+bool RobotPlanner::Stuck() const {
+  const std::size_t n = static_cast<std::size_t>(options_.stuck_calls);
+  if (history_.size() <= n) return false;
+  return (history_.back() - history_[history_.size() - 1 - n]).norm() < options_.stuck_m;
+}
+
+void RobotPlanner::BuildKeyFrame(const FloorInput& floor, const RobotInput& robot, double t_s,
+                                 StepOutput* out) {
+  const double t0 = NowMs();
+  key_centre_ = robot.position_m;
+  window_ = CropFloor(floor, key_centre_, options_.window_m);
+  const KeyFrameParams kp;
+  TensorRaster next = WindowKeyFrame(window_, kp, options_.fill);
+  const double t1 = NowMs();
+  frames_.clear();
+  if (have_key_ && options_.frames_k >= 2) {
+    const TensorRaster previous = Reindex(key_, next);
+    MaskParams mp;
+    mp.use_window = true;
+    mp.window_centre_m = robot.position_m;
+    mp.window_radius_m = options_.interp_window_m;
+    const std::vector<std::uint8_t> mask = InterpolationMask(previous, next, mp);
+    SpaceTimeParams sp;
+    sp.mode = options_.interp;
+    sp.rows = SpaceTimeRows::kInteriorFrames;
+    sp.substeps = options_.frames_k;
+    SpaceTimeResult r = InterpolateFrames(previous, next, mask, sp);
+    if (r.status.ok() && r.frames.size() == static_cast<std::size_t>(options_.frames_k) + 1)
+      frames_ = std::move(r.frames);
+  }
+  if (frames_.empty()) frames_.push_back(next);
+  min_magnitude_ = 1e-5 * MaxFieldMagnitude(next);
+  key_ = std::move(next);
+  key_t_s_ = t_s;
+  have_key_ = true;
+  out->diag.keyframe = true;
+  out->diag.field_ms = t1 - t0;
+  out->diag.interp_ms = NowMs() - t1;
+}
+
+void RobotPlanner::BuildTopology(const RobotInput& robot, const ViewGain& gain, StepOutput* out) {
+  const TensorRaster& frame = frames_[static_cast<std::size_t>(sub_)];
+  TopologyParams tp;
+  tp.min_relative_magnitude = 1e-5;
+  key_points_ = FindDegeneratePoints(frame, tp);
+  SkeletonParams sp;
+  sp.min_relative_magnitude = 1e-5;
+  sp.block_clearance_m = robot.radius_m;
+  sp.max_length_m = 2.0 * options_.window_m;
+  AdvectionObstacles obstacles;
+  obstacles.clearance = &window_.clearance;
+  skeleton_ = ExtractSkeleton(frame, key_points_, sp, obstacles);
+  edge_gain_ = EdgeGains(skeleton_, [&](const SkeletonEdge& e) {
+    return MeanAlongPolyline(
+        e.polyline, [&](const Eigen::Vector2d& p) { return gain.PointGain(p); }, 0.3);
+  });
+  edge_access_ = EdgeAccessibility(skeleton_, [&](const SkeletonEdge& e) {
+    return EdgeClear(e, window_.clearance, robot.radius_m);
+  });
+  for (const SkeletonEdge& e : skeleton_.edges) out->skeleton_edges.push_back(e.polyline);
+}
+
+Pathline RobotPlanner::Advect(const RobotInput& robot, double heading_rad, double length_m,
+                              const std::vector<DegeneratePoint>& points) const {
+  AdvectionParams ap;
+  ap.max_length_m = length_m;
+  ap.min_magnitude = min_magnitude_;
+  ap.max_speed_mps = options_.speed_mps;
+  ap.min_speed_mps = std::min(0.05, options_.speed_mps);
+  ap.frame_spacing_m = options_.substep_s * options_.speed_mps;
+  ap.block_clearance_m = robot.radius_m + options_.clearance_margin_m;
+  ap.wall_clearance_m = std::max(0.3, ap.block_clearance_m + 0.05);
+  ap.stop_at_wedges = ap.stop_at_trisectors = true;
+  // A robot already closer to a wall than its radius (a bump) may still move along or away.
+  const int c = window_.geometry.IndexOf(robot.position_m);
+  const double start_clearance = c >= 0 ? window_.clearance.At(c) : 0.0;
+  const double need = std::min(robot.radius_m, start_clearance) - 1e-3;
+  AdvectionObstacles obstacles;
+  obstacles.clearance = &window_.clearance;
+  obstacles.traversable = [this, need](const Eigen::Vector2d& p) { return Traversable(p, need); };
+  const std::span<const TensorRaster> frames(frames_.data() + sub_, frames_.size() - sub_);
+  return AdvectPathline(frames, robot.position_m, heading_rad, points, ap, obstacles);
+}
+
+std::optional<RobotPlanner::Route> RobotPlanner::SeparatrixRoute(const RobotInput& robot,
+                                                                 double t_s) {
+  const int root = RoutingRoot(skeleton_, robot.position_m, 0.5);
+  if (root < 0) return std::nullopt;
+  const Eigen::Vector2d root_m = skeleton_.nodes[static_cast<std::size_t>(root)].position_m;
+  if ((root_m - robot.position_m).norm() > 1.0) return std::nullopt;
+  if ((root_m - last_branch_root_).norm() < 0.3 && t_s - last_branch_t_s_ < kBranchHoldS)
+    return std::nullopt;
+  RoutingParams rp;
+  rp.termination_gain = options_.gain_threshold;
+  const BranchChoice b = ChooseBranch(skeleton_, edge_gain_, root, edge_access_, rp);
+  if (b.edge < 0) return std::nullopt;
+  const SkeletonEdge& e = skeleton_.edges[static_cast<std::size_t>(b.edge)];
+  std::vector<Eigen::Vector2d> line = e.polyline;
+  if (e.from != root) std::reverse(line.begin(), line.end());
+  // From the polyline point nearest the robot on.
+  std::size_t nearest = 0;
+  for (std::size_t i = 1; i < line.size(); ++i)
+    if ((line[i] - robot.position_m).norm() < (line[nearest] - robot.position_m).norm())
+      nearest = i;
+  std::vector<Eigen::Vector2d> from_robot = {robot.position_m};
+  from_robot.insert(from_robot.end(), line.begin() + static_cast<long>(nearest) + 1, line.end());
+  const int c = window_.geometry.IndexOf(robot.position_m);
+  const double need = std::min(robot.radius_m, c >= 0 ? double(window_.clearance.At(c)) : 0.0);
+  std::vector<Eigen::Vector2d> prefix = TraversablePrefix(from_robot, need - 1e-3);
+  if (PolylineLength(prefix) < kRouteDoneM) return std::nullopt;
+  last_branch_root_ = root_m;
+  last_branch_t_s_ = t_s;
+  ++branch_choices_;
+  Route route;
+  route.kind = StepMode::kSeparatrix;
+  route.goal = prefix.back();
+  route.deadline_s = t_s + 2.0 * PolylineLength(prefix) / options_.speed_mps + 5.0;
+  route.polyline = std::move(prefix);
+  return route;
+}
+
+namespace {
+
+// Unsettled frontier cells of the floor, dilated to the cells within approach_m of one.
+std::vector<std::uint8_t> FrontierTargets(const FloorInput& floor,
+                                          const std::function<bool(int)>& settled,
+                                          double approach_m, bool* any) {
+  const std::size_t n = floor.cells.size();
+  std::vector<std::uint8_t> mask(n, 0);
+  *any = false;
+  for (std::size_t i = 0; i < n; ++i) {
+    if (floor.cells[i] != kFloorFrontier || settled(static_cast<int>(i))) continue;
+    mask[i] = 1;
+    *any = true;
+  }
+  if (!*any) return mask;
+  const int r =
+      std::max(0, static_cast<int>(std::lround(approach_m / floor.geometry.resolution_m)));
+  return DilateMask(floor.geometry, mask, r);
+}
+
+}  // namespace
+
+bool RobotPlanner::FrontierReachable(const FloorInput& floor, const RobotInput& robot,
+                                     const RouteServices& services) const {
+  bool any = false;
+  const std::vector<std::uint8_t> targets = FrontierTargets(
+      floor, [&](int c) { return Settled(floor, c); }, kApproachM, &any);
+  if (!any) return false;
+  if (!services.geodesic) return true;
+  const std::vector<float> field =
+      services.geodesic(robot.position_m, robot.radius_m + options_.clearance_margin_m);
+  for (std::size_t i = 0; i < targets.size() && i < field.size(); ++i)
+    if (targets[i] != 0 && std::isfinite(field[i])) return true;
+  return false;
+}
+
+std::optional<RobotPlanner::Route> RobotPlanner::FrontierRoute(const FloorInput& floor,
+                                                               const RobotInput& robot, double t_s,
+                                                               const RouteServices& services) {
+  if (!services.geodesic || !services.shortest_path) return std::nullopt;
+  const double clearance = robot.radius_m + options_.clearance_margin_m;
+  const std::vector<float> field = services.geodesic(robot.position_m, clearance);
+  const omt::RasterGeometry& g = floor.geometry;
+  for (int attempt = 0; attempt < 8; ++attempt) {
+    bool any = false;
+    const std::vector<std::uint8_t> targets = FrontierTargets(
+        floor, [&](int c) { return Settled(floor, c); }, kApproachM, &any);
+    if (!any) return std::nullopt;
+    int best = -1;
+    for (std::size_t i = 0; i < targets.size() && i < field.size(); ++i) {
+      if (targets[i] == 0 || !std::isfinite(field[i])) continue;
+      if (best < 0 || field[i] < field[static_cast<std::size_t>(best)]) best = static_cast<int>(i);
+    }
+    if (best < 0) return std::nullopt;
+    const Eigen::Vector2d goal = g.Center(best);
+    if ((goal - robot.position_m).norm() < 0.3) {
+      // Already there and the frontier did not resolve: settle it, try the next one.
+      SettleAround(floor, goal);
+      continue;
+    }
+    std::optional<std::vector<Eigen::Vector2d>> path =
+        services.shortest_path(robot.position_m, goal, clearance);
+    if (!path || path->empty()) return std::nullopt;
+    std::vector<Eigen::Vector2d> line = {robot.position_m};
+    for (const Eigen::Vector2d& p : *path)
+      if ((p - line.back()).norm() > 1e-3) line.push_back(p);
+    Route route;
+    route.kind = StepMode::kFrontier;
+    route.goal = goal;
+    route.deadline_s = t_s + 2.0 * PolylineLength(line) / options_.speed_mps + 10.0;
+    route.polyline = std::move(line);
+    return route;
+  }
+  return std::nullopt;
+}
+
+void RobotPlanner::SettleAround(const FloorInput& floor, const Eigen::Vector2d& goal) {
+  const omt::RasterGeometry& g = floor.geometry;
+  for (int i = 0; i < g.NumCells(); ++i)
+    if (floor.cells[static_cast<std::size_t>(i)] == kFloorFrontier &&
+        (g.Center(i) - goal).norm() <= kSettleRadiusM)
+      settled_.insert(KeyOf(g, i));
+  visited_goals_.push_back(goal);
+}
+
+StepOutput RobotPlanner::Step(const FloorInput& floor, const RobotInput& robot, double sim_time_s,
+                              const RouteServices& services) {
+  StepOutput out;
+  out.wakeup_t_s = sim_time_s + options_.substep_s;
+  history_.push_back(robot.position_m);
+  if (history_.size() > 32) history_.erase(history_.begin());
+
+  // Key frame when due (every substeps_per_keyframe sub-steps, or the robot nears the window's
+  // edge), else the current window re-read on the key frame's grid.
+  const double substep = options_.substep_s;
+  const bool due =
+      !have_key_ || sim_time_s - key_t_s_ >= options_.substeps_per_keyframe * substep - 1e-6 ||
+      (robot.position_m - key_centre_).norm() > options_.window_m - options_.lookahead_m - 0.5;
+  if (due) {
+    BuildKeyFrame(floor, robot, sim_time_s, &out);
+  } else {
+    window_ = CropFloor(floor, key_centre_, options_.window_m);
+  }
+  // The sub-step: by the time since the key frame (the loop's calls come at its own steps).
+  const int first = std::max(0, options_.frames_k - options_.substeps_per_keyframe);
+  const int elapsed = static_cast<int>(std::floor((sim_time_s - key_t_s_) / substep + 1e-6));
+  sub_ = frames_.size() <= 1 ? 0
+                             : std::clamp(first + elapsed, 0, static_cast<int>(frames_.size()) - 1);
+  out.diag.substep = sub_;
+
+  // The gain model on the current window; settled cells count as seen.
+  std::vector<std::uint8_t> codes = window_.codes;
+  for (int i = 0; i < window_.geometry.NumCells() && !settled_.empty(); ++i)
+    if (settled_.count(KeyOf(window_.geometry, i)) > 0)
+      codes[static_cast<std::size_t>(i)] = kFloorFree;
+  GainParams gp;
+  gp.range_m = robot.max_range_m;
+  gp.near_m = std::max(0.3, robot.min_range_m);
+  gp.fov_rad = robot.fov_rad;
+  const ViewGain gain(window_.geometry, std::move(codes), gp);
+
+  const double topo_t0 = NowMs();
+  if (due) BuildTopology(robot, gain, &out);
+  TopologyParams tp;
+  tp.min_relative_magnitude = 1e-5;
+  const std::vector<DegeneratePoint> points =
+      FindDegeneratePoints(frames_[static_cast<std::size_t>(sub_)], tp);
+  out.diag.topology_ms = NowMs() - topo_t0;
+  out.diag.degenerate_points = static_cast<int>(points.size());
+  for (const DegeneratePoint& p : points) {
+    (p.type == DegenerateType::kWedge ? out.diag.wedges : out.diag.trisectors)++;
+    out.degenerate_xy.push_back(p.position_m);
+  }
+  out.diag.skeleton_edges = static_cast<int>(skeleton_.edges.size());
+  RoutingParams rp;
+  rp.termination_gain = options_.gain_threshold;
+  const TerminationCheck term = CheckTermination(edge_gain_, edge_access_, rp);
+  out.diag.max_edge_gain = term.max_accessible_gain;
+
+  auto finish = [&]() -> StepOutput {
+    out.diag.fallback_routes = fallback_routes_;
+    out.diag.blocked = blocked_.blocked;
+    out.diag.pathlines = blocked_.pathlines;
+    out.diag.branch_choices = branch_choices_;
+    out.diag.settled_goals = static_cast<int>(visited_goals_.size());
+    return std::move(out);
+  };
+  // X7: no accessible edge with gain, and (ours) no frontier anyone could still reach.
+  if (term.done && !FrontierReachable(floor, robot, services)) {
+    out.done = true;
+    route_.reset();
+    return finish();
+  }
+  const bool stuck = Stuck();
+  auto fallback = [&]() -> bool {
+    std::optional<Route> r = FrontierRoute(floor, robot, sim_time_s, services);
+    if (!r) return false;
+    ++fallback_routes_;
+    route_ = std::move(r);
+    history_.clear();
+    history_.push_back(robot.position_m);
+    return true;
+  };
+
+  // A route in progress (a separatrix or a fallback to a frontier).
+  if (route_) {
+    const Route& r = *route_;
+    std::size_t nearest = 0;
+    for (std::size_t i = 1; i < r.polyline.size(); ++i)
+      if ((r.polyline[i] - robot.position_m).norm() <
+          (r.polyline[nearest] - robot.position_m).norm())
+        nearest = i;
+    std::vector<Eigen::Vector2d> rest = {robot.position_m};
+    rest.insert(rest.end(), r.polyline.begin() + static_cast<long>(nearest) + 1, r.polyline.end());
+    bool resolved = false;
+    if (r.kind == StepMode::kFrontier) {
+      resolved = true;
+      const omt::RasterGeometry& g = floor.geometry;
+      for (int i = 0; i < g.NumCells() && resolved; ++i)
+        resolved = !(floor.cells[static_cast<std::size_t>(i)] == kFloorFrontier &&
+                     (g.Center(i) - r.goal).norm() <= kSettleRadiusM && !Settled(floor, i));
+    }
+    const bool arrived = PolylineLength(rest) < kRouteDoneM;
+    if (arrived && r.kind == StepMode::kFrontier && !resolved) SettleAround(floor, r.goal);
+    if (stuck && r.kind == StepMode::kFrontier) SettleAround(floor, r.goal);
+    if (arrived || resolved || stuck || sim_time_s > r.deadline_s) {
+      route_.reset();
+    } else {
+      std::vector<float> speeds(rest.size(), static_cast<float>(options_.speed_mps));
+      out.diag.mode = r.kind;
+      EmitLine(rest, speeds, robot, gain, &out);
+      return finish();
+    }
+  }
+
+  // Advection over the frames from the current sub-step (X4).
+  const double adv_t0 = NowMs();
+  const double min_move = 0.5 * substep * options_.speed_mps;
+  Pathline line = Advect(robot, robot.heading_rad, options_.lookahead_m, points);
+  blocked_.Add(line);
+  out.diag.stop = static_cast<int>(line.stop);
+  bool need_fallback = false;
+  if (line.Length() < min_move) {
+    const bool at_point =
+        line.stop == AdvectionStop::kWedge || line.stop == AdvectionStop::kTrisector;
+    if (at_point && options_.topology_routing) {
+      // X5, X6: stopped at a wedge or trisector: leave along the branch with the most gain.
+      std::optional<Route> r = SeparatrixRoute(robot, sim_time_s);
+      out.diag.advect_ms = NowMs() - adv_t0;
+      if (r) {
+        route_ = std::move(r);
+        std::vector<float> speeds(route_->polyline.size(), static_cast<float>(options_.speed_mps));
+        out.diag.mode = StepMode::kSeparatrix;
+        EmitLine(route_->polyline, speeds, robot, gain, &out);
+        return finish();
+      }
+    }
+    if (at_point && !options_.topology_routing && line.stop == AdvectionStop::kTrisector &&
+        line.stop_point >= 0) {
+      // Without routing, at a trisector: the freest separatrix, the one advecting farthest.
+      Pathline best;
+      for (double a : points[static_cast<std::size_t>(line.stop_point)].separatrix_angles_rad) {
+        Pathline l = Advect(robot, a, options_.lookahead_m, points);
+        if (l.Length() > best.Length() + 1e-9) best = std::move(l);
+      }
+      line = std::move(best);
+    } else {
+      // A wedge (a dead end of the line field), an obstacle, the known map's edge or a flat
+      // field ahead: turn round and advect the other way.
+      line = Advect(robot, robot.heading_rad + omt::kPi, options_.lookahead_m, points);
+    }
+    need_fallback = line.Length() < min_move;
+  }
+  out.diag.advect_ms = NowMs() - adv_t0;
+  // The field alone gives nothing to see along the way.
+  double look_gain = 0.0;
+  for (std::size_t i = 0; i < line.points.size(); i += 6)
+    look_gain = std::max(look_gain, gain.PointGain(line.points[i].position_m));
+  out.diag.lookahead_gain = look_gain;
+  no_gain_streak_ = look_gain < options_.gain_threshold ? no_gain_streak_ + 1 : 0;
+  if (no_gain_streak_ >= options_.no_gain_calls || stuck) need_fallback = true;
+  if (need_fallback && fallback()) {
+    no_gain_streak_ = 0;
+    std::vector<float> speeds(route_->polyline.size(), static_cast<float>(options_.speed_mps));
+    out.diag.mode = StepMode::kFrontier;
+    EmitLine(route_->polyline, speeds, robot, gain, &out);
+    return finish();
+  }
+  if (line.Length() >= 1e-3) {
+    std::vector<Eigen::Vector2d> xy;
+    std::vector<float> speeds;
+    for (const PathPoint& p : line.points) {
+      xy.push_back(p.position_m);
+      speeds.push_back(static_cast<float>(std::max(p.speed_mps, 0.05)));
+    }
+    out.diag.mode = StepMode::kAdvect;
+    EmitLine(xy, speeds, robot, gain, &out);
+  }
+  return finish();
+}
+
+}  // namespace voxplan::tensorfield

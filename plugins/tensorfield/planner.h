@@ -1,0 +1,182 @@
+// The tensorfield planner's logic for one robot over plain data (Xu et al. 2017, Alg. 1 mapped
+// onto the exploration loop's calls; plugins/tensorfield/README.md): key frames over a window
+// around the robot, the space-time frames between them stepped through one sub-step at a time,
+// a pathline advected over them and sent as a continuous path, wedge and trisector stops with
+// routing over the topological skeleton, the frontier fallback, the camera trajectory of X eq.
+// 7-8 and termination. The plugin (plugin.cpp) only reads the host's world into these structs
+// and writes the step back. Deterministic; prints nothing.
+#pragma once
+
+#include <Eigen/Core>
+#include <cstdint>
+#include <functional>
+#include <optional>
+#include <set>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "plugins/tensorfield/algorithms/advection.h"
+#include "plugins/tensorfield/algorithms/camera_path.h"
+#include "plugins/tensorfield/algorithms/skeleton.h"
+#include "plugins/tensorfield/algorithms/tensor_field.h"
+#include "plugins/tensorfield/frames.h"
+
+namespace voxplan::tensorfield {
+
+class ViewGain;  // gain.h
+
+struct PlannerOptions {
+  double substep_s = 0.4;         // X§6: 0.4 s sub-steps
+  int substeps_per_keyframe = 5;  // Alg. 1 drives sub-steps K/2 .. K-1 of each key frame
+  int frames_k = 10;              // K (X§6, Fig. 15)
+  double speed_mps = 0.3;         // X L304
+  double window_m = 6.0;          // half-width of the key frame's window
+  double interp_window_m = 3.0;   // the space-time solve's disc around the robot
+  InterpolationMode interp = InterpolationMode::kSpaceTime;
+  bool topology_routing = true;
+  CameraMode camera = CameraMode::kOptimized;
+  double gain_threshold = 0.01;      // X L229
+  double clearance_margin_m = 0.05;  // beyond the robot radius, as the host's own routes keep
+  double lookahead_m = 2.0;          // the pathline the camera is planned along
+  double camera_sample_m = 0.3;      // its samples
+  int sent_substeps = 3;             // X4: a pathline of three sub-steps is sent
+  FillParams fill;
+  // Stuck: less progress than stuck_m over the last stuck_calls calls.
+  double stuck_m = 0.05;
+  int stuck_calls = 6;
+  // No gain: the best view along the lookahead below gain_threshold this many calls in a row.
+  int no_gain_calls = 4;
+};
+
+// The robot and its camera as the plugin read them.
+struct RobotInput {
+  Eigen::Vector2d position_m = Eigen::Vector2d::Zero();
+  double heading_rad = 0.0;
+  double radius_m = 0.2;
+  double camera_height_m = 1.2;
+  double fov_rad = 1.5707963;
+  double min_range_m = 0.3;
+  double max_range_m = 5.0;
+  double max_speed_mps = 0.5;
+  double floor_z_m = 0.0;
+  bool arm = false;  // camera on an arm (its workspace below), else a head over the base
+  CameraWorkspace workspace;
+  double min_pitch_rad = -0.5, max_pitch_rad = 0.5;
+};
+
+// The host's geodesic queries (empty functions in unit tests: every frontier counts as
+// reachable and no fallback route is found).
+struct RouteServices {
+  // Geodesic distance from `from` to every floor cell over cells with that clearance (+inf:
+  // unreachable), row-major over FloorInput's geometry.
+  std::function<std::vector<float>(const Eigen::Vector2d& from, double clearance_m)> geodesic;
+  std::function<std::optional<std::vector<Eigen::Vector2d>>(
+      const Eigen::Vector2d& from, const Eigen::Vector2d& to, double clearance_m)>
+      shortest_path;
+};
+
+struct CameraOut {
+  float t_s = 0.f;
+  Eigen::Vector3f position_m = Eigen::Vector3f::Zero();
+  float yaw_rad = 0.f, pitch_rad = 0.f;
+};
+
+// What drove the path sent (diagnostic "mode").
+enum class StepMode : std::uint8_t { kAdvect = 0, kSeparatrix = 1, kFrontier = 2, kNone = 3 };
+
+struct StepDiagnostics {
+  double field_ms = -1.0, interp_ms = -1.0;  // only on a key-frame call; -1 otherwise
+  double topology_ms = 0.0, advect_ms = 0.0, traj_ms = 0.0;
+  int degenerate_points = 0, wedges = 0, trisectors = 0, skeleton_edges = 0;
+  double max_edge_gain = 0.0;
+  double lookahead_gain = 0.0;
+  int fallback_routes = 0;  // cumulative
+  int blocked = 0;          // cumulative blocked pathlines
+  int pathlines = 0;        // cumulative
+  int branch_choices = 0;   // cumulative
+  int substep = 0;
+  bool keyframe = false;
+  StepMode mode = StepMode::kNone;
+  int stop = -1;  // AdvectionStop of this call's pathline, -1 when none was advected
+  int settled_goals = 0;
+};
+
+struct StepOutput {
+  std::vector<Eigen::Vector2d> path;  // starts at the robot; empty: nothing sent
+  std::vector<double> headings_rad;
+  std::vector<float> speeds_mps;
+  std::vector<CameraOut> camera;
+  double wakeup_t_s = 0.0;
+  bool done = false;  // X7 and no reachable frontier
+  StepDiagnostics diag;
+  // Debug drawings, world xy.
+  std::vector<Eigen::Vector2d> lookahead;
+  std::vector<Eigen::Vector2d> degenerate_xy;
+  std::vector<std::vector<Eigen::Vector2d>> skeleton_edges;
+};
+
+// One robot's planner state across calls.
+class RobotPlanner {
+ public:
+  explicit RobotPlanner(const PlannerOptions& options) : options_(options) {}
+  StepOutput Step(const FloorInput& floor, const RobotInput& robot, double sim_time_s,
+                  const RouteServices& services);
+
+ private:
+  struct Route {
+    StepMode kind = StepMode::kNone;
+    std::vector<Eigen::Vector2d> polyline;
+    Eigen::Vector2d goal = Eigen::Vector2d::Zero();
+    double deadline_s = 0.0;
+  };
+  using Key = std::pair<long, long>;
+
+  void BuildKeyFrame(const FloorInput& floor, const RobotInput& robot, double t_s, StepOutput* out);
+  void BuildTopology(const RobotInput& robot, const ViewGain& gain, StepOutput* out);
+  Pathline Advect(const RobotInput& robot, double heading_rad, double length_m,
+                  const std::vector<DegeneratePoint>& points) const;
+  bool Traversable(const Eigen::Vector2d& p, double radius_m) const;
+  std::vector<Eigen::Vector2d> TraversablePrefix(const std::vector<Eigen::Vector2d>& line,
+                                                 double radius_m) const;
+  std::optional<Route> SeparatrixRoute(const RobotInput& robot, double t_s);
+  void SettleAround(const FloorInput& floor, const Eigen::Vector2d& goal);
+  std::optional<Route> FrontierRoute(const FloorInput& floor, const RobotInput& robot, double t_s,
+                                     const RouteServices& services);
+  bool FrontierReachable(const FloorInput& floor, const RobotInput& robot,
+                         const RouteServices& services) const;
+  bool Settled(const FloorInput& floor, int cell) const;
+  Key KeyOf(const omt::RasterGeometry& g, int cell) const;
+  bool Stuck() const;
+  void EmitLine(const std::vector<Eigen::Vector2d>& line, const std::vector<float>& speeds,
+                const RobotInput& robot, const ViewGain& gain, StepOutput* out);
+
+  PlannerOptions options_;
+  // Key frames and the frames between them.
+  bool have_key_ = false;
+  TensorRaster key_;
+  double key_t_s_ = 0.0;
+  Eigen::Vector2d key_centre_ = Eigen::Vector2d::Zero();
+  FloorWindow window_;
+  std::vector<TensorRaster> frames_;
+  int sub_ = 0;  // the current sub-step's frame
+  double min_magnitude_ = 0.0;
+  // The skeleton of the key frame's first driven frame, its edges' gains and accessibility.
+  std::vector<DegeneratePoint> key_points_;
+  Skeleton skeleton_;
+  std::vector<double> edge_gain_;
+  std::vector<std::uint8_t> edge_access_;
+  // Motion.
+  std::optional<Route> route_;
+  std::vector<Eigen::Vector2d> history_;  // robot positions at the last calls
+  int no_gain_streak_ = 0;
+  Eigen::Vector2d last_branch_root_ = Eigen::Vector2d::Constant(1e9);
+  double last_branch_t_s_ = -1e9;
+  std::set<Key> settled_;  // frontier cells near goals the robot reached and did not resolve
+  std::vector<Eigen::Vector2d> visited_goals_;
+  BlockedPathCounter blocked_;
+  int fallback_routes_ = 0;
+  int branch_choices_ = 0;
+};
+
+}  // namespace voxplan::tensorfield

@@ -1,0 +1,153 @@
+#!/usr/bin/env python3
+"""Summary of scripts/tensorfield-suite (issue 31, Xu 2017): medians per variant, paired ratios of
+tensorfield against each other variant with bootstrap intervals of the median and the share of
+pairs below 1, and the targets of issue 31 that the runs can judge.
+
+  scripts/tensorfield_suite_summary.py OUT_DIR      writes OUT_DIR/summary.json and summary.md
+  scripts/tensorfield_suite_summary.py --self-test  checks the statistics on made-up runs
+"""
+import json
+import pathlib
+import statistics
+import sys
+
+sys.path.insert(0, str(pathlib.Path(__file__).resolve().parent))
+from taskflow_suite_summary import median_interval, num  # noqa: E402  (the same bootstrap)
+
+METRICS = [("time_s", "time s"), ("distance_total_m", "travel m"),
+           ("base_ang_accel_radps2", "|ang. acc.| rad/s²"), ("base_sharp_turns_per_10m", "sharp/10 m"),
+           ("completeness_below_robot", "compl. <1.8 m"), ("blocked_paths", "blocked"),
+           ("plan_ms_median", "plan ms")]
+
+
+def parse_name(name):
+    """<scene>_<variant>_s<seed> -> (scene, variant, seed); variants hold no '_'."""
+    head, _, seed = name.rpartition("_s")
+    scene, _, variant = head.rpartition("_")
+    return scene, variant, seed
+
+
+def load(out):
+    runs = []
+    for d in sorted(p for p in pathlib.Path(out).iterdir() if (p / "metrics.json").exists()):
+        scene, variant, seed = parse_name(d.name)
+        runs.append({"scene": scene, "variant": variant, "seed": seed,
+                     "m": json.loads((d / "metrics.json").read_text())})
+    return runs
+
+
+def medians(runs):
+    out = {}
+    for v in sorted({r["variant"] for r in runs}):
+        rs = [r for r in runs if r["variant"] == v]
+        row = {"runs": len(rs), "done": sum(r["m"].get("terminated") == "done" for r in rs) / len(rs)}
+        for key, _ in METRICS:
+            vals = [r["m"][key] for r in rs if num(r["m"].get(key))]
+            row[key] = statistics.median(vals) if vals else None
+        out[v] = row
+    return out
+
+
+def paired(runs, a, b, key):
+    """Ratios a/b over runs sharing scene and seed: median, its interval, share below 1."""
+    by = {(r["scene"], r["seed"]): r["m"].get(key) for r in runs if r["variant"] == b}
+    ratios = []
+    for r in runs:
+        if r["variant"] != a:
+            continue
+        other = by.get((r["scene"], r["seed"]))
+        mine = r["m"].get(key)
+        if num(mine) and num(other) and other > 0:
+            ratios.append(mine / other)
+    if not ratios:
+        return None
+    lo, hi = median_interval(ratios)
+    return {"pairs": len(ratios), "median": statistics.median(ratios), "ci95": [lo, hi],
+            "below_1": sum(x < 1 for x in ratios) / len(ratios)}
+
+
+def targets(runs, med):
+    rows = []
+
+    def add(label, comp, ok):
+        rows.append({"target": label, "status": "n/a" if comp is None else ("met" if ok(comp) else "not met"),
+                     "comparison": comp})
+    t = paired(runs, "tensorfield", "notopo", "time_s")
+    add("topology routing vs none: time <= 0.70, below 1 in >= 80 % of pairs", t,
+        lambda c: c["median"] <= 0.70 and c["below_1"] >= 0.8)
+    t = paired(runs, "tensorfield", "notopo", "distance_total_m")
+    add("topology routing vs none: travel <= 0.80, below 1 in >= 80 % of pairs", t,
+        lambda c: c["median"] <= 0.80 and c["below_1"] >= 0.8)
+    t = paired(runs, "tensorfield", "linear", "base_ang_accel_radps2")
+    add("space-time smoother than linear in >= 70 % of pairs", t, lambda c: c["below_1"] >= 0.7)
+    done = med.get("tensorfield", {}).get("done")
+    rows.append({"target": ">= 90 % of tensorfield runs end done",
+                 "status": "n/a" if done is None else ("met" if done >= 0.9 else "not met"),
+                 "comparison": {"median": done}})
+    c = med.get("tensorfield", {}).get("completeness_below_robot")
+    rows.append({"target": "completeness of the observable surface below robot height >= 0.90 (median)",
+                 "status": "n/a" if c is None else ("met" if c >= 0.9 else "not met"),
+                 "comparison": {"median": c}})
+    return rows
+
+
+def fmt(x, d=3):
+    return "-" if x is None else (f"{x:.{d}f}" if isinstance(x, float) else str(x))
+
+
+def render(med, comps, tgts):
+    lines = ["## Medians per variant", "",
+             "| variant | runs | done | " + " | ".join(label for _, label in METRICS) + " |",
+             "|---" * (3 + len(METRICS)) + "|"]
+    for v, row in med.items():
+        lines.append(f"| {v} | {row['runs']} | {row['done'] * 100:.0f} % | " +
+                     " | ".join(fmt(row[k]) for k, _ in METRICS) + " |")
+    lines += ["", "## tensorfield / variant (paired medians, 95 % bootstrap interval, share of pairs below 1)", "",
+              "| variant | metric | pairs | median | 95 % interval | below 1 |", "|---|---|---|---|---|---|"]
+    for (v, key), c in comps.items():
+        if c:
+            lines.append(f"| {v} | {key} | {c['pairs']} | {c['median']:.3f} | "
+                         f"{c['ci95'][0]:.3f} - {c['ci95'][1]:.3f} | {c['below_1'] * 100:.0f} % |")
+    lines += ["", "## Targets (issue 31)", "", "| target | status | value |", "|---|---|---|"]
+    for t in tgts:
+        c = t["comparison"] or {}
+        lines.append(f"| {t['target']} | {t['status']} | {fmt(c.get('median'))} |")
+    return "\n".join(lines) + "\n"
+
+
+def summarise(out):
+    runs = load(out)
+    med = medians(runs)
+    comps = {(v, key): paired(runs, "tensorfield", v, key)
+             for v in med if v != "tensorfield" for key, _ in METRICS[:5]}
+    tgts = targets(runs, med)
+    text = render(med, comps, tgts)
+    print(text)
+    pathlib.Path(out, "summary.json").write_text(json.dumps(
+        {"runs": len(runs), "variants": med, "targets": tgts,
+         "comparisons": {f"{v}:{k}": c for (v, k), c in comps.items()}}, indent=2) + "\n")
+    pathlib.Path(out, "summary.md").write_text(f"# tensorfield-suite summary: {out}\n\n" + text)
+
+
+def self_test():
+    runs = []
+    for seed in "123":
+        for v, t in [("tensorfield", 50.0), ("notopo", 100.0)]:
+            runs.append({"scene": "apt_R_1", "variant": v, "seed": seed,
+                         "m": {"time_s": t * (1 + int(seed) / 100), "terminated": "done"}})
+    c = paired(runs, "tensorfield", "notopo", "time_s")
+    assert c["pairs"] == 3 and abs(c["median"] - 0.5) < 1e-12 and c["below_1"] == 1.0, c
+    assert parse_name("apt_R_2_notopo_s3") == ("apt_R_2", "notopo", "3")
+    assert parse_name("small-house-visual_tensorfield_s1") == ("small-house-visual", "tensorfield", "1")
+    tg = targets(runs, medians(runs))
+    assert tg[0]["status"] == "met", tg[0]
+    print("self-test passed")
+
+
+if __name__ == "__main__":
+    if sys.argv[1:] == ["--self-test"]:
+        self_test()
+    elif len(sys.argv) == 2:
+        summarise(sys.argv[1])
+    else:
+        sys.exit(__doc__)
