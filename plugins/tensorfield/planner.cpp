@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <limits>
 #include <span>
 
 #include "plugins/omt/algorithms/raster_ops.h"
@@ -192,6 +193,77 @@ std::optional<RobotPlanner::Route> RobotPlanner::SeparatrixRoute(const RobotInpu
   return route;
 }
 
+// X L136: routing over the skeleton "at any time step". When the field ahead gives nothing to see,
+// the robot drives to the skeleton edge with the most gain that the spanning tree from its
+// nearest node reaches (costs 1 / mean gain, X6), per metre of the way there (the edge's nearest
+// free point, over the known map); the frontier fallback comes only after that. An edge point once
+// routed to is not a target again (its gain is the key frame's, and the robot has now looked from
+// there).
+std::optional<RobotPlanner::Route> RobotPlanner::SkeletonRoute(const FloorInput& floor,
+                                                               const RobotInput& robot, double t_s,
+                                                               const RouteServices& services) {
+  if (!services.shortest_path || !services.geodesic || skeleton_.edges.empty()) return std::nullopt;
+  const int root = RoutingRoot(skeleton_, robot.position_m, 0.5);
+  if (root < 0) return std::nullopt;
+  RoutingParams rp;
+  rp.termination_gain = options_.gain_threshold;
+  std::vector<double> cost(edge_gain_.size());
+  for (std::size_t e = 0; e < cost.size(); ++e) cost[e] = EdgeCost(edge_gain_[e], rp);
+  const SpanningTree tree = MinimumSpanningTree(skeleton_, cost, root, edge_access_);
+  const int c = window_.geometry.IndexOf(robot.position_m);
+  const double need = std::min(robot.radius_m, c >= 0 ? double(window_.clearance.At(c)) : 0.0);
+  const auto visited = [&](const Eigen::Vector2d& p) {
+    for (const Eigen::Vector2d& g : skeleton_goals_)
+      if ((g - p).norm() < kSettleRadiusM) return true;
+    return false;
+  };
+  // Per tree edge with gain, its free, new point nearest the robot by the geodesic distance d;
+  // edges by gain per metre driven, gain / (1 + d), best first (ties: lower index).
+  const double clearance = robot.radius_m + options_.clearance_margin_m;
+  const std::vector<float> field = services.geodesic(robot.position_m, clearance);
+  struct Target {
+    Eigen::Vector2d goal;
+    double value;
+  };
+  std::vector<Target> targets;
+  for (const int e : tree.edges) {
+    const double g = edge_gain_[static_cast<std::size_t>(e)];
+    if (g < options_.gain_threshold) continue;
+    double best_d = std::numeric_limits<double>::infinity();
+    Eigen::Vector2d best_p = Eigen::Vector2d::Zero();
+    for (const Eigen::Vector2d& p : skeleton_.edges[static_cast<std::size_t>(e)].polyline) {
+      const int cell = floor.geometry.IndexOf(p);
+      if (cell < 0 || static_cast<std::size_t>(cell) >= field.size()) continue;
+      const double d = field[static_cast<std::size_t>(cell)];
+      if (!std::isfinite(d) || d >= best_d || !Traversable(p, need) || visited(p)) continue;
+      best_d = d;
+      best_p = p;
+    }
+    if (std::isfinite(best_d)) targets.push_back({best_p, g / (1.0 + best_d)});
+  }
+  std::stable_sort(targets.begin(), targets.end(),
+                   [](const Target& a, const Target& b) { return a.value > b.value; });
+  for (const Target& t : targets) {
+    const Eigen::Vector2d goal = t.goal;
+    skeleton_goals_.push_back(goal);
+    if ((goal - robot.position_m).norm() < kRouteDoneM) continue;
+    std::optional<std::vector<Eigen::Vector2d>> path =
+        services.shortest_path(robot.position_m, goal, clearance);
+    if (!path || path->empty()) continue;
+    std::vector<Eigen::Vector2d> poly = {robot.position_m};
+    for (const Eigen::Vector2d& p : *path)
+      if ((p - poly.back()).norm() > 1e-3) poly.push_back(p);
+    ++skeleton_routes_;
+    Route route;
+    route.kind = StepMode::kSkeleton;
+    route.goal = goal;
+    route.deadline_s = t_s + 2.0 * PolylineLength(poly) / options_.speed_mps + 10.0;
+    route.polyline = std::move(poly);
+    return route;
+  }
+  return std::nullopt;
+}
+
 namespace {
 
 // Unsettled frontier cells of the floor, dilated to the cells within approach_m of one.
@@ -336,6 +408,7 @@ StepOutput RobotPlanner::Step(const FloorInput& floor, const RobotInput& robot, 
     out.diag.blocked = blocked_.blocked;
     out.diag.pathlines = blocked_.pathlines;
     out.diag.branch_choices = branch_choices_;
+    out.diag.skeleton_routes = skeleton_routes_;
     out.diag.settled_goals = static_cast<int>(visited_goals_.size());
     return std::move(out);
   };
@@ -433,6 +506,18 @@ StepOutput RobotPlanner::Step(const FloorInput& floor, const RobotInput& robot, 
   out.diag.lookahead_gain = look_gain;
   no_gain_streak_ = look_gain < options_.gain_threshold ? no_gain_streak_ + 1 : 0;
   if (no_gain_streak_ >= options_.no_gain_calls || stuck) need_fallback = true;
+  if (need_fallback && !stuck && options_.topology_routing) {
+    if (std::optional<Route> r = SkeletonRoute(floor, robot, sim_time_s, services)) {
+      no_gain_streak_ = 0;
+      route_ = std::move(r);
+      history_.clear();
+      history_.push_back(robot.position_m);
+      std::vector<float> speeds(route_->polyline.size(), static_cast<float>(options_.speed_mps));
+      out.diag.mode = StepMode::kSkeleton;
+      EmitLine(route_->polyline, speeds, robot, gain, &out);
+      return finish();
+    }
+  }
   if (need_fallback && fallback()) {
     no_gain_streak_ = 0;
     std::vector<float> speeds(route_->polyline.size(), static_cast<float>(options_.speed_mps));

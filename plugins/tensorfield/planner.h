@@ -83,7 +83,13 @@ struct CameraOut {
 };
 
 // What drove the path sent (diagnostic "mode").
-enum class StepMode : std::uint8_t { kAdvect = 0, kSeparatrix = 1, kFrontier = 2, kNone = 3 };
+enum class StepMode : std::uint8_t {
+  kAdvect = 0,
+  kSeparatrix = 1,
+  kFrontier = 2,
+  kNone = 3,
+  kSkeleton = 4  // global routing to the skeleton edge with the most gain (X L136)
+};
 
 struct StepDiagnostics {
   double field_ms = -1.0, interp_ms = -1.0;  // only on a key-frame call; -1 otherwise
@@ -95,6 +101,7 @@ struct StepDiagnostics {
   int blocked = 0;          // cumulative blocked pathlines
   int pathlines = 0;        // cumulative
   int branch_choices = 0;   // cumulative
+  int skeleton_routes = 0;  // cumulative: global routes over the skeleton
   int substep = 0;
   bool keyframe = false;
   StepMode mode = StepMode::kNone;
@@ -140,6 +147,8 @@ class RobotPlanner {
   std::vector<Eigen::Vector2d> TraversablePrefix(const std::vector<Eigen::Vector2d>& line,
                                                  double radius_m) const;
   std::optional<Route> SeparatrixRoute(const RobotInput& robot, double t_s);
+  std::optional<Route> SkeletonRoute(const FloorInput& floor, const RobotInput& robot, double t_s,
+                                     const RouteServices& services);
   void SettleAround(const FloorInput& floor, const Eigen::Vector2d& goal);
   std::optional<Route> FrontierRoute(const FloorInput& floor, const RobotInput& robot, double t_s,
                                      const RouteServices& services);
@@ -177,6 +186,8 @@ class RobotPlanner {
   BlockedPathCounter blocked_;
   int fallback_routes_ = 0;
   int branch_choices_ = 0;
+  int skeleton_routes_ = 0;
+  std::vector<Eigen::Vector2d> skeleton_goals_;  // edge points routed to: not targets again
 };
 
 }  // namespace voxplan::tensorfield

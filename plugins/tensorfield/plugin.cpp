@@ -172,6 +172,7 @@ class TensorfieldPlanner : public vp::Planner {
     out.Diagnostic("blocked" + s, d.blocked);
     out.Diagnostic("pathlines" + s, d.pathlines);
     out.Diagnostic("branch_choices" + s, d.branch_choices);
+    out.Diagnostic("skeleton_routes" + s, d.skeleton_routes);
     out.Diagnostic("settled_goals" + s, d.settled_goals);
     out.Diagnostic("mode" + s, double(d.mode));
     out.Diagnostic("stop" + s, d.stop);
