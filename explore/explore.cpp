@@ -815,6 +815,11 @@ void Explorer::CallPlanner(PlanEvent event, int32_t event_robot, const PlannerTa
     return;
   } else {
     for (const PlanLogEntry& e : plan->log) result_.plan_log.push_back(head + e.message);
+    if (p_.keep_planner_drawings) {
+      std::map<std::string, std::vector<DebugDrawing>> sent;
+      for (const DebugDrawing& d : plan->drawings) sent[d.layer].push_back(d);
+      for (auto& [layer, drawings] : sent) result_.planner_drawings[layer] = std::move(drawings);
+    }
     record.rejections = plan->rejections.size();
     record.done = plan->done;
     record.elapsed_ms = plan->elapsed_ms;

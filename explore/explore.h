@@ -26,6 +26,7 @@
 // (LoadedPlanner::fault()): the loop stops there and the result holds what it recorded so far.
 #include <Eigen/Core>
 #include <functional>
+#include <map>
 #include <memory>
 #include <optional>
 #include <string>
@@ -62,7 +63,8 @@ struct ExploreParams {
   // How the reconstruction volume weighs a frame's depth: 1/z² (Voxblox's default, which Guo 2022
   // fused with) lets a close scan outweigh far, noisier ones; the planning map stays constant.
   Weighting recon_weighting = Weighting::kConstant;
-  bool noise = true;  // Kinect noise on the rendered depth
+  bool noise = true;                   // Kinect noise on the rendered depth
+  bool keep_planner_drawings = false;  // ExploreResult::planner_drawings (a picture of them)
   // Where frames are fused: at the true camera pose, or (kTracked, Xu 2017's registration) at
   // the pose FrameTracker estimates against the map from a noisy odometry prior, frames it loses
   // skipped. Each robot's start sweep anchors its map at the truth (a frame must overlap the map
@@ -190,6 +192,9 @@ struct ExploreResult {
   std::vector<std::string> plan_log;          // rejections, failures and the plugin's messages
   std::optional<PlannerFault> planner_fault;  // the call that ended the run, for planner_*
   std::vector<RunTimePoint> series;
+  // With ExploreParams::keep_planner_drawings: per debug layer, the drawings of the last plan
+  // call that sent that layer (the planner's field, skeleton, paths at the end of the run).
+  std::map<std::string, std::vector<DebugDrawing>> planner_drawings;
   ExploreTimings timings;
   // The maps at the end.
   std::unique_ptr<TsdfVolume> volume;

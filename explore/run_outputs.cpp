@@ -220,8 +220,27 @@ Status WriteTimeline(const ExploreResult& r, const std::string& path) {
   return WriteFileAtomically(path, *svg);
 }
 
-// Top-down picture: the final floor map, paths, start and end marks, task views.
-Status WriteTopDown(const ExploreResult& r, const std::string& path) {
+// The planner's last debug drawings as an overlay: lines (layers in name order), then points over
+// them.
+TopDownOverlay PlannerOverlay(const ExploreResult& r) {
+  TopDownOverlay overlay;
+  for (const DebugDrawing::Kind kind : {DebugDrawing::Kind::kPolyline, DebugDrawing::Kind::kPoints})
+    for (const auto& [layer, drawings] : r.planner_drawings)
+      for (const DebugDrawing& d : drawings) {
+        if (d.kind != kind) continue;  // labels: no text in the picture
+        TopDownOverlay::Stroke stroke;
+        stroke.polyline = d.kind == DebugDrawing::Kind::kPolyline;
+        stroke.color = PackRgb(uint8_t(d.rgba >> 24), uint8_t(d.rgba >> 16), uint8_t(d.rgba >> 8));
+        for (const Eigen::Vector3f& p : d.points) stroke.points_W.push_back(p.head<2>());
+        overlay.strokes.push_back(std::move(stroke));
+      }
+  return overlay;
+}
+
+// Top-down picture: the final floor map, paths, start and end marks, task views (and, given one,
+// an overlay under the paths).
+Status WriteTopDown(const ExploreResult& r, const std::string& path,
+                    const TopDownOverlay& overlay = {}) {
   TopDownRaster raster;
   const FloorGeometry& g = r.floor->geometry();
   raster.origin_W = g.origin_cell.cast<float>() * g.cell_size_m;
@@ -247,7 +266,7 @@ Status WriteTopDown(const ExploreResult& r, const std::string& path) {
     paths.push_back(std::move(tp));
   }
   if (g.width > 0) {
-    Result<ColorImage> picture = RenderTopDown(raster, paths);
+    Result<ColorImage> picture = RenderTopDown(raster, paths, {}, overlay);
     if (!picture.ok()) return picture.status();
     if (Status s = WriteColorPng(path, *picture); !s.ok()) return s.Naming(path);
   }
@@ -306,14 +325,16 @@ Status WriteRunOutputs(const ExploreRunParams& params, const ExploreRunReport& r
   path = InFolder(params.out_dir, "objects.csv");
   if (Status s = WriteLines(ObjectRows(report.objects), path); !s.ok()) return s.Naming(path);
   VOXPLAN_RETURN_IF_ERROR(WriteTimeline(r, InFolder(params.out_dir, "timeline.svg")));
-  return WriteTopDown(r, InFolder(params.out_dir, "topdown.png"));
+  VOXPLAN_RETURN_IF_ERROR(WriteTopDown(r, InFolder(params.out_dir, "topdown.png")));
+  if (!params.explore.keep_planner_drawings) return Status();
+  return WriteTopDown(r, InFolder(params.out_dir, "planner.png"), PlannerOverlay(r));
 }
 
 std::vector<std::string> RunOutputFiles(const std::string& out_dir) {
   std::vector<std::string> paths;
-  for (const char* name :
-       {"mesh.ply", "metrics.json", "run_log.csv", "timeseries.csv", "plan_log.txt",
-        "plan_calls.csv", "objects.csv", "robot.json", "timeline.svg", "topdown.png"})
+  for (const char* name : {"mesh.ply", "metrics.json", "run_log.csv", "timeseries.csv",
+                           "plan_log.txt", "plan_calls.csv", "objects.csv", "robot.json",
+                           "timeline.svg", "topdown.png", "planner.png"})
     paths.push_back(InFolder(out_dir, name));
   return paths;
 }

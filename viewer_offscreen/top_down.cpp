@@ -78,7 +78,7 @@ uint32_t RobotColor(size_t k) {
 }
 
 Result<ColorImage> RenderTopDown(const TopDownRaster& raster, const std::vector<TopDownPath>& paths,
-                                 const TopDownParams& params) {
+                                 const TopDownParams& params, const TopDownOverlay& overlay) {
   const Image<uint8_t>& classes = raster.classes;
   if (classes.empty() || classes.width <= 0 || classes.height <= 0)
     return InvalidArgument("top-down render: the floor raster is empty");
@@ -104,6 +104,10 @@ Result<ColorImage> RenderTopDown(const TopDownRaster& raster, const std::vector<
                                " has a non-finite task view");
   }
 
+  for (const TopDownOverlay::Stroke& stroke : overlay.strokes)
+    for (const Eigen::Vector2f& p : stroke.points_W)
+      if (!p.allFinite()) return InvalidArgument("top-down render: an overlay point is not finite");
+
   const int s = params.pixels_per_cell;
   ColorImage image(classes.width * s, classes.height * s);
   for (int y = 0; y < classes.height; ++y)
@@ -122,7 +126,20 @@ Result<ColorImage> RenderTopDown(const TopDownRaster& raster, const std::vector<
 
   Canvas canvas(image);
   const float width = float(params.line_width_px), mark = float(params.mark_radius_px);
-  // Paths first, then the marks over every path, so no path hides another robot's marks.
+  // The overlay over the floor, thinner than the paths; then the paths, then the marks over
+  // every path, so no path hides another robot's marks.
+  for (const TopDownOverlay::Stroke& stroke : overlay.strokes) {
+    const std::vector<Eigen::Vector2f>& pts = stroke.points_W;
+    if (stroke.polyline) {
+      for (size_t i = 1; i < pts.size(); ++i)
+        canvas.Line(to_px(pts[i - 1]), to_px(pts[i]), std::max(1.f, 0.5f * width), stroke.color);
+    } else {
+      for (const Eigen::Vector2f& p : pts) {
+        const Eigen::Vector2f c = to_px(p);
+        canvas.Disc(c.x(), c.y(), 0.5f * mark, stroke.color);
+      }
+    }
+  }
   for (size_t r = 0; r < paths.size(); ++r) {
     const std::vector<Eigen::Vector2f>& pts = paths[r].points_W;
     for (size_t i = 1; i < pts.size(); ++i)

@@ -32,6 +32,17 @@ struct TopDownPath {
   std::vector<TopDownView> views;         // task views it was sent to
 };
 
+// Drawings over the floor and under the paths: a planner's debug layers (its field, skeleton,
+// points), world xy, packed RGB colours.
+struct TopDownOverlay {
+  struct Stroke {
+    std::vector<Eigen::Vector2f> points_W;
+    uint32_t color = 0;
+    bool polyline = true;  // else separate dots
+  };
+  std::vector<Stroke> strokes;  // drawn in order
+};
+
 struct TopDownParams {
   int pixels_per_cell = 2;
   int line_width_px = 2;
@@ -49,6 +60,7 @@ uint32_t RobotColor(size_t k);
 // resolution, a scale that would make the picture larger than 16384 pixels a side, and
 // non-finite path points.
 Result<ColorImage> RenderTopDown(const TopDownRaster& raster, const std::vector<TopDownPath>& paths,
-                                 const TopDownParams& params = {});
+                                 const TopDownParams& params = {},
+                                 const TopDownOverlay& overlay = {});
 
 }  // namespace voxplan

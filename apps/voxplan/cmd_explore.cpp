@@ -356,6 +356,10 @@ Command AddExploreCommand(CLI::App& app) {
       ->delimiter(',')
       ->expected(2)
       ->check(CLI::Range(0.0, 1.0));
+  sub->add_flag("--planner-picture", run.explore.keep_planner_drawings,
+                "Also write planner.png: topdown.png with the planner's debug drawings over the "
+                "floor, each layer as the last plan call that sent it drew it (a tensor field's "
+                "glyphs, degenerate points and skeleton)");
   sub->add_flag("--no-color", o->no_color,
                 "Render and fuse no colour (a grey mesh.ply; the metrics do not change)");
   positive("--planning-interval", run.explore.planning_interval_s,

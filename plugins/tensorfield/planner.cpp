@@ -132,6 +132,16 @@ void RobotPlanner::BuildTopology(const RobotInput& robot, const ViewGain& gain, 
     return EdgeClear(e, window_.clearance, robot.radius_m);
   });
   for (const SkeletonEdge& e : skeleton_.edges) out->skeleton_edges.push_back(e.polyline);
+  constexpr double kGlyphSpacingM = 0.4, kGlyphHalfM = 0.15;
+  const omt::RasterGeometry& g = frame.geometry;
+  const int step = std::max(1, static_cast<int>(std::lround(kGlyphSpacingM / g.resolution_m)));
+  for (int y = step / 2; y < g.height; y += step)
+    for (int x = step / 2; x < g.width; x += step) {
+      const int i = g.Index(x, y);
+      if (!frame.InDomain(i) || frame.At(i).norm() <= min_magnitude_) continue;
+      const Eigen::Vector2d c = g.Center(x, y), d = kGlyphHalfM * MajorEigenvector(frame.At(i));
+      out->field_glyphs.push_back({c - d, c + d});
+    }
 }
 
 Pathline RobotPlanner::Advect(const RobotInput& robot, double heading_rad, double length_m,

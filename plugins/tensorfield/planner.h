@@ -8,6 +8,7 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <array>
 #include <cstdint>
 #include <functional>
 #include <optional>
@@ -121,6 +122,9 @@ struct StepOutput {
   std::vector<Eigen::Vector2d> lookahead;
   std::vector<Eigen::Vector2d> degenerate_xy;
   std::vector<std::vector<Eigen::Vector2d>> skeleton_edges;
+  // At a key frame: the field as glyphs, a short segment along the major eigenvector every
+  // 0.4 m of the window where the field is not flat (for the run's picture).
+  std::vector<std::array<Eigen::Vector2d, 2>> field_glyphs;
 };
 
 // One robot's planner state across calls.

@@ -16,7 +16,8 @@ namespace voxplan::tensorfield {
 namespace {
 
 constexpr uint32_t kPathColor = 0xe15759ffu, kLookaheadColor = 0xf28e2bffu;
-constexpr uint32_t kPointColor = 0x59a14fffu, kSkeletonColor = 0x4e79a7ffu;
+constexpr uint32_t kPointColor = 0x59a14fffu, kSkeletonColor = 0xb07aa1ffu;
+constexpr uint32_t kFieldColor = 0xb0b0b0ffu;
 
 PlannerOptions ReadOptions(const std::string& json_text) {
   planners::JsonOptions json("tensorfield", json_text);
@@ -181,6 +182,8 @@ class TensorfieldPlanner : public vp::Planner {
       out.DebugPoints("tensorfield_degenerate", Xyz(step.degenerate_xy, z), kPointColor);
     for (const auto& e : step.skeleton_edges)
       if (e.size() >= 2) out.DebugPolyline("tensorfield_skeleton", Xyz(e, z), kSkeletonColor);
+    for (const auto& glyph : step.field_glyphs)
+      out.DebugPolyline("tensorfield_field", Xyz({glyph[0], glyph[1]}, z), kFieldColor);
     if (step.lookahead.size() >= 2)
       out.DebugPolyline("tensorfield_lookahead", Xyz(step.lookahead, z), kLookaheadColor);
     if (step.path.size() < 2) return;

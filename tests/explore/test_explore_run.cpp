@@ -51,6 +51,29 @@ std::vector<std::string> Lines(const fs::path& path) {
   return lines;
 }
 
+TEST(ExploreRun, PlannerPictureDrawsTheLastDrawingsOfEachLayer) {
+  // --planner-picture: greedy sends its view points and path as debug layers; planner.png is
+  // topdown.png with them drawn in, so the two differ and the run's drawings are kept per layer.
+  test::TempDir dir("explore_picture");
+  std::unique_ptr<LoadedPlanner> planner = Greedy();
+  ASSERT_NE(planner, nullptr);
+  ExploreRunParams params = ShortRun(dir / "out");
+  params.explore.max_time_s = 30.0;
+  params.explore.keep_planner_drawings = true;
+  bool refused = true;
+  Result<ExploreRunReport> report = RunExploreExperiment(params, *planner, {}, &refused);
+  ASSERT_TRUE(report.ok()) << report.status().message();
+  ASSERT_FALSE(report->loop.planner_drawings.empty());
+  for (const auto& [layer, drawings] : report->loop.planner_drawings)
+    EXPECT_FALSE(drawings.empty());
+  const fs::path picture = dir / "out" / "planner.png", plain = dir / "out" / "topdown.png";
+  ASSERT_TRUE(fs::is_regular_file(picture));
+  std::ifstream a(picture, std::ios::binary), b(plain, std::ios::binary);
+  const std::string bytes_a((std::istreambuf_iterator<char>(a)), {}),
+      bytes_b((std::istreambuf_iterator<char>(b)), {});
+  EXPECT_NE(bytes_a, bytes_b);
+}
+
 TEST(ExploreRun, ShortRunWritesEveryArtefactAndItsMetricsAgree) {
   test::TempDir dir("explore_run");
   std::unique_ptr<LoadedPlanner> planner = Greedy();
@@ -74,6 +97,7 @@ TEST(ExploreRun, ShortRunWritesEveryArtefactAndItsMetricsAgree) {
     EXPECT_TRUE(fs::is_regular_file(dir / "out" / f)) << f;
   EXPECT_GT(fs::file_size(dir / "out" / "mesh.ply"), 1000u);
   EXPECT_GT(fs::file_size(dir / "out" / "topdown.png"), 1000u);
+  EXPECT_FALSE(fs::exists(dir / "out" / "planner.png"));  // only with keep_planner_drawings
 
   // The report: a reconstructed surface, judged against the tour-observable ground truth.
   const ExploreResult& loop = report->loop;

@@ -27,6 +27,32 @@ Eigen::Vector2i Pixel(const TopDownRaster& r, const Eigen::Vector2f& p_W, int he
   return {int(q.x()), height_px - 1 - int(q.y())};
 }
 
+TEST(TopDown, OverlayLinesAndDotsLieUnderThePaths) {
+  // A planner's drawings: a line along y = 2 crossing a path along x = 3, and a dot at (7, 1).
+  const TopDownRaster floor = Floor();
+  TopDownPath path;
+  path.points_W = {{3.f, 0.f}, {3.f, 4.f}};
+  TopDownOverlay overlay;
+  const uint32_t line = PackRgb(10, 200, 30), dot = PackRgb(200, 10, 30);
+  overlay.strokes.push_back({{{0.f, 2.f}, {4.5f, 2.f}}, line, true});
+  overlay.strokes.push_back({{{7.f, 1.f}}, dot, false});
+  auto image = RenderTopDown(floor, {path}, {}, overlay);
+  ASSERT_TRUE(image.ok()) << image.status().message();
+  const Eigen::Vector2i on_line = Pixel(floor, {1.f, 2.f}, 120);
+  EXPECT_EQ(image->at(on_line.x(), on_line.y()), line);
+  const Eigen::Vector2i crossing = Pixel(floor, {3.f, 2.f}, 120);
+  EXPECT_EQ(image->at(crossing.x(), crossing.y()), RobotColor(0));  // the path over it
+  const Eigen::Vector2i at_dot = Pixel(floor, {7.f, 1.f}, 120);
+  EXPECT_EQ(image->at(at_dot.x(), at_dot.y()), dot);
+  // Without the overlay the same pixels are floor.
+  auto plain = RenderTopDown(floor, {path});
+  ASSERT_TRUE(plain.ok());
+  EXPECT_NE(plain->at(on_line.x(), on_line.y()), line);
+  // A non-finite overlay point is refused.
+  overlay.strokes.push_back({{{std::nanf(""), 0.f}}, dot, false});
+  EXPECT_FALSE(RenderTopDown(floor, {path}, {}, overlay).ok());
+}
+
 TEST(TopDown, CellsPathsAndMarksLandWhereTheWorldSaysTheyAre) {
   const TopDownRaster floor = Floor();
   TopDownParams params;
