@@ -99,9 +99,13 @@ PlannerMapInfo ExploreWorld::MapInfo() const {
   return info;
 }
 
+// Both queries are answered point by point (ray by ray) in parallel: each answer depends on its
+// own input and the map only, so the result is the same for any thread count.
 void ExploreWorld::VoxelStates(std::span<const Eigen::Vector3f> points,
                                std::span<VoxelState> out) const {
-  for (size_t i = 0; i < points.size(); ++i) out[i] = map_->StateAt(points[i]);
+  ParallelFor(points.size(), 1024, [&](size_t begin, size_t end) {
+    for (size_t i = begin; i < end; ++i) out[i] = map_->StateAt(points[i]);
+  });
 }
 
 void ExploreWorld::Raycast(std::span<const PlannerRay> rays, std::span<PlannerRayHit> out) const {
@@ -110,27 +114,39 @@ void ExploreWorld::Raycast(std::span<const PlannerRay> rays, std::span<PlannerRa
   const float step = 0.5f * map_->volume().voxel_size_m();
   const PlannerMapInfo info = MapInfo();
   const Eigen::Vector3f lo = info.bounds_min, hi = info.bounds_max;
-  for (size_t i = 0; i < rays.size(); ++i) {
-    const PlannerRay& ray = rays[i];
-    PlannerRayHit hit;
-    hit.distance_m = ray.max_range_m;
-    for (float s = 0.f; s <= ray.max_range_m; s += step) {
-      const Eigen::Vector3f p = ray.origin + s * ray.direction;
-      if ((p.array() < lo.array()).any() || (p.array() > hi.array()).any()) {
-        hit.distance_m = s;
-        hit.result = RayResult::kLeftMap;
-        break;
+  const float voxel = map_->volume().voxel_size_m();
+  ParallelFor(rays.size(), 64, [&](size_t begin, size_t end) {
+    for (size_t i = begin; i < end; ++i) {
+      const PlannerRay& ray = rays[i];
+      PlannerRayHit hit;
+      hit.distance_m = ray.max_range_m;
+      // Consecutive half-voxel steps often stay in one voxel: its state is looked up once.
+      GlobalVoxelIndex last{};
+      VoxelState state = VoxelState::kUnobserved;
+      bool have_last = false;
+      for (float s = 0.f; s <= ray.max_range_m; s += step) {
+        const Eigen::Vector3f p = ray.origin + s * ray.direction;
+        if ((p.array() < lo.array()).any() || (p.array() > hi.array()).any()) {
+          hit.distance_m = s;
+          hit.result = RayResult::kLeftMap;
+          break;
+        }
+        const GlobalVoxelIndex g = VoxelAt(p, voxel);
+        if (!have_last || !(g == last)) {
+          state = map_->StateAt(g);
+          last = g;
+          have_last = true;
+        }
+        if (state == VoxelState::kOccupied) {
+          hit.distance_m = s;
+          hit.result = RayResult::kSurface;
+          break;
+        }
+        if (state == VoxelState::kUnobserved) hit.unobserved_m += step;
       }
-      const VoxelState state = map_->StateAt(p);
-      if (state == VoxelState::kOccupied) {
-        hit.distance_m = s;
-        hit.result = RayResult::kSurface;
-        break;
-      }
-      if (state == VoxelState::kUnobserved) hit.unobserved_m += step;
+      out[i] = hit;
     }
-    out[i] = hit;
-  }
+  });
 }
 
 std::vector<Eigen::Vector3f> ExploreWorld::FrontierVoxels() const {
