@@ -6,6 +6,7 @@ pairs below 1, and the targets of issue 31 that the runs can judge.
   scripts/tensorfield_suite_summary.py OUT_DIR      writes OUT_DIR/summary.json and summary.md
   scripts/tensorfield_suite_summary.py --self-test  checks the statistics on made-up runs
 """
+import csv
 import json
 import pathlib
 import statistics
@@ -32,8 +33,29 @@ def load(out):
     for d in sorted(p for p in pathlib.Path(out).iterdir() if (p / "metrics.json").exists()):
         scene, variant, seed = parse_name(d.name)
         runs.append({"scene": scene, "variant": variant, "seed": seed,
-                     "m": json.loads((d / "metrics.json").read_text())})
+                     "m": json.loads((d / "metrics.json").read_text()), "dir": d})
     return runs
+
+
+def census(run):
+    """Per key frame of a tensorfield run (plan_calls.csv diagnostics): degenerate points over
+    the normal- and the tangent-oriented vector fields' singularities, from the same constraints
+    (frames where the vector field has none are left out). Returns the two lists of ratios."""
+    ratios = {"normal": [], "tangent": []}
+    path = run["dir"] / "plan_calls.csv" if "dir" in run else None
+    if path is None or not path.exists():
+        return ratios
+    with open(path, newline="") as f:
+        for row in csv.DictReader(f):
+            d = dict(kv.split("=", 1) for kv in row.get("diagnostics", "").split(";") if "=" in kv)
+            if "census_degenerate" not in d:
+                continue
+            points = float(d["census_degenerate"])
+            for kind in ratios:
+                singular = float(d.get(f"census_vector_{kind}", "0"))
+                if points >= 0 and singular > 0:
+                    ratios[kind].append(points / singular)
+    return ratios
 
 
 def medians(runs):
@@ -80,6 +102,12 @@ def targets(runs, med):
         lambda c: c["median"] <= 0.80 and c["below_1"] >= 0.8)
     t = paired(runs, "tensorfield", "linear", "base_ang_accel_radps2")
     add("space-time smoother than linear in >= 70 % of pairs", t, lambda c: c["below_1"] >= 0.7)
+    for kind in ("normal", "tangent"):
+        per_run = [statistics.median(r) for r in (census(run)[kind] for run in runs
+                                                   if run["variant"] == "tensorfield") if r]
+        comp = {"median": statistics.median(per_run), "pairs": len(per_run)} if per_run else None
+        add(f"degenerate points <= 0.5 x the {kind}-oriented vector field's singularities "
+            "(median over runs of the per-key-frame median)", comp, lambda c: c["median"] <= 0.5)
     done = med.get("tensorfield", {}).get("done")
     rows.append({"target": ">= 90 % of tensorfield runs end done",
                  "status": "n/a" if done is None else ("met" if done >= 0.9 else "not met"),

@@ -84,8 +84,26 @@ void RobotPlanner::BuildKeyFrame(const FloorInput& floor, const RobotInput& robo
   key_centre_ = robot.position_m;
   window_ = CropFloor(floor, key_centre_, options_.window_m);
   const KeyFrameParams kp;
-  TensorRaster next = WindowKeyFrame(window_, kp, options_.fill);
+  std::vector<BoundarySample> samples;
+  TensorRaster next = WindowKeyFrame(window_, kp, options_.fill, &samples);
   const double t1 = NowMs();
+  // The census of X Fig. 2 and 17 from the same constraints, before the fill: degenerate points
+  // of the paper's blend against the singularities of the normal- and tangent-oriented vector
+  // blends (diagnostics only; the planner drives the filled field).
+  {
+    const std::vector<std::uint8_t> domain = FieldDomain(window_.raster, kp.include_unknown);
+    const TensorRaster raw = BlendTensorField(window_.geometry, samples, domain, kp);
+    out->diag.census_degenerate = static_cast<int>(FindDegeneratePoints(raw).size());
+    out->diag.census_vector_normal =
+        static_cast<int>(FindVectorSingularities(BlendVectorField(window_.geometry, samples, domain,
+                                                                  VectorConstraint::kNormal, kp))
+                             .size());
+    out->diag.census_vector_tangent =
+        static_cast<int>(FindVectorSingularities(BlendVectorField(window_.geometry, samples, domain,
+                                                                  VectorConstraint::kTangent, kp))
+                             .size());
+  }
+  const double t_census = NowMs();
   frames_.clear();
   if (have_key_ && options_.frames_k >= 2) {
     const TensorRaster previous = Reindex(key_, next);
@@ -109,7 +127,8 @@ void RobotPlanner::BuildKeyFrame(const FloorInput& floor, const RobotInput& robo
   have_key_ = true;
   out->diag.keyframe = true;
   out->diag.field_ms = t1 - t0;
-  out->diag.interp_ms = NowMs() - t1;
+  out->diag.interp_ms = NowMs() - t_census;
+  out->diag.census_ms = t_census - t1;
 }
 
 void RobotPlanner::BuildTopology(const RobotInput& robot, const ViewGain& gain, StepOutput* out) {

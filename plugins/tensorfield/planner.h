@@ -108,6 +108,10 @@ struct StepDiagnostics {
   StepMode mode = StepMode::kNone;
   int stop = -1;  // AdvectionStop of this call's pathline, -1 when none was advected
   int settled_goals = 0;
+  // Key-frame calls only (-1 otherwise): the same constraints' degenerate points (the paper's
+  // blend, unfilled) and the normal- and tangent-oriented vector fields' singularities.
+  int census_degenerate = -1, census_vector_normal = -1, census_vector_tangent = -1;
+  double census_ms = -1.0;
 };
 
 struct StepOutput {

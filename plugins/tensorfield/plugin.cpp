@@ -157,6 +157,10 @@ class TensorfieldPlanner : public vp::Planner {
     if (d.keyframe) {
       out.Diagnostic("field_ms" + s, d.field_ms);
       out.Diagnostic("interp_ms" + s, d.interp_ms);
+      out.Diagnostic("census_ms" + s, d.census_ms);
+      out.Diagnostic("census_degenerate" + s, d.census_degenerate);
+      out.Diagnostic("census_vector_normal" + s, d.census_vector_normal);
+      out.Diagnostic("census_vector_tangent" + s, d.census_vector_tangent);
     }
     out.Diagnostic("keyframe" + s, d.keyframe ? 1.0 : 0.0);
     out.Diagnostic("topology_ms" + s, d.topology_ms);
