@@ -276,21 +276,33 @@ std::optional<RobotPlanner::Route> RobotPlanner::SkeletonRoute(const FloorInput&
     const Eigen::Vector2d goal = t.goal;
     skeleton_goals_.push_back(goal);
     if ((goal - robot.position_m).norm() < kRouteDoneM) continue;
-    std::optional<std::vector<Eigen::Vector2d>> path =
-        services.shortest_path(robot.position_m, goal, clearance);
-    if (!path || path->empty()) continue;
-    std::vector<Eigen::Vector2d> poly = {robot.position_m};
-    for (const Eigen::Vector2d& p : *path)
-      if ((p - poly.back()).norm() > 1e-3) poly.push_back(p);
+    std::optional<Route> route =
+        RouteOverMap(StepMode::kSkeleton, robot.position_m, goal, clearance, t_s, services);
+    if (!route) continue;
     ++skeleton_routes_;
-    Route route;
-    route.kind = StepMode::kSkeleton;
-    route.goal = goal;
-    route.deadline_s = t_s + 2.0 * PolylineLength(poly) / options_.speed_mps + 10.0;
-    route.polyline = std::move(poly);
     return route;
   }
   return std::nullopt;
+}
+
+std::optional<RobotPlanner::Route> RobotPlanner::RouteOverMap(StepMode kind,
+                                                              const Eigen::Vector2d& from,
+                                                              const Eigen::Vector2d& goal,
+                                                              double clearance_m, double t_s,
+                                                              const RouteServices& services) const {
+  std::optional<std::vector<Eigen::Vector2d>> path =
+      services.shortest_path(from, goal, clearance_m);
+  if (!path || path->empty()) return std::nullopt;
+  std::vector<Eigen::Vector2d> line = {from};
+  for (const Eigen::Vector2d& p : *path)
+    if ((p - line.back()).norm() > 1e-3) line.push_back(p);
+  Route route;
+  route.kind = kind;
+  route.goal = goal;
+  // Twice the drive at speed plus slack: a route that takes longer is given up.
+  route.deadline_s = t_s + 2.0 * PolylineLength(line) / options_.speed_mps + 10.0;
+  route.polyline = std::move(line);
+  return route;
 }
 
 namespace {
@@ -353,18 +365,7 @@ std::optional<RobotPlanner::Route> RobotPlanner::FrontierRoute(const FloorInput&
       SettleAround(floor, goal);
       continue;
     }
-    std::optional<std::vector<Eigen::Vector2d>> path =
-        services.shortest_path(robot.position_m, goal, clearance);
-    if (!path || path->empty()) return std::nullopt;
-    std::vector<Eigen::Vector2d> line = {robot.position_m};
-    for (const Eigen::Vector2d& p : *path)
-      if ((p - line.back()).norm() > 1e-3) line.push_back(p);
-    Route route;
-    route.kind = StepMode::kFrontier;
-    route.goal = goal;
-    route.deadline_s = t_s + 2.0 * PolylineLength(line) / options_.speed_mps + 10.0;
-    route.polyline = std::move(line);
-    return route;
+    return RouteOverMap(StepMode::kFrontier, robot.position_m, goal, clearance, t_s, services);
   }
   return std::nullopt;
 }

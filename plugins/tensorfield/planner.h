@@ -155,6 +155,10 @@ class RobotPlanner {
   std::vector<Eigen::Vector2d> TraversablePrefix(const std::vector<Eigen::Vector2d>& line,
                                                  double radius_m) const;
   std::optional<Route> SeparatrixRoute(const RobotInput& robot, double t_s);
+  // The host's shortest path from `from` to `goal` as a route of that kind; none without one.
+  std::optional<Route> RouteOverMap(StepMode kind, const Eigen::Vector2d& from,
+                                    const Eigen::Vector2d& goal, double clearance_m, double t_s,
+                                    const RouteServices& services) const;
   std::optional<Route> SkeletonRoute(const FloorInput& floor, const RobotInput& robot, double t_s,
                                      const RouteServices& services);
   void SettleAround(const FloorInput& floor, const Eigen::Vector2d& goal);
