@@ -100,6 +100,13 @@ def targets(runs, med):
     t = paired(runs, "tensorfield", "notopo", "distance_total_m")
     add("topology routing vs none: travel <= 0.80, below 1 in >= 80 % of pairs", t,
         lambda c: c["median"] <= 0.80 and c["below_1"] >= 0.8)
+    # X T3: against the harmonic-function method, both with the fixed forward camera (X L429).
+    t = paired(runs, "fixedcam", "harmonic", "time_s")
+    add("vs the harmonic-function method, same fixed camera: time <= 0.75 (fixedcam / harmonic)", t,
+        lambda c: c["median"] <= 0.75)
+    t = paired(runs, "fixedcam", "harmonic", "distance_total_m")
+    add("vs the harmonic-function method, same fixed camera: travel <= 0.85 (fixedcam / harmonic)",
+        t, lambda c: c["median"] <= 0.85)
     t = paired(runs, "tensorfield", "linear", "base_ang_accel_radps2")
     add("space-time smoother than linear in >= 70 % of pairs", t, lambda c: c["below_1"] >= 0.7)
     for kind in ("normal", "tangent"):

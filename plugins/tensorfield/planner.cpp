@@ -10,6 +10,7 @@
 
 #include "plugins/omt/algorithms/raster_ops.h"
 #include "plugins/tensorfield/gain.h"
+#include "plugins/tensorfield/harmonic.h"
 
 namespace voxplan::tensorfield {
 namespace {
@@ -443,7 +444,8 @@ StepOutput RobotPlanner::Step(const FloorInput& floor, const RobotInput& robot, 
     return std::move(out);
   };
   // X7: no accessible edge with gain, and (ours) no frontier anyone could still reach.
-  if (term.done && !FrontierReachable(floor, robot, services)) {
+  const bool tensor = options_.method == Method::kTensor;
+  if ((term.done || !tensor) && !FrontierReachable(floor, robot, services)) {
     out.done = true;
     route_.reset();
     return finish();
@@ -490,9 +492,34 @@ StepOutput RobotPlanner::Step(const FloorInput& floor, const RobotInput& robot, 
     }
   }
 
+  const double min_move = 0.5 * substep * options_.speed_mps;
+  if (!tensor) {
+    // The harmonic baseline: down φ over the window around the robot, every call anew.
+    const double t0 = NowMs();
+    const FloorWindow w = CropFloor(floor, robot.position_m, options_.window_m);
+    const std::vector<double> phi = SolveHarmonic(w.geometry, w.codes);
+    const double need = robot.radius_m + options_.clearance_margin_m;
+    const std::vector<Eigen::Vector2d> xy = DescendHarmonic(
+        w.geometry, phi, w.codes, robot.position_m,
+        options_.sent_substeps * substep * options_.speed_mps,
+        [&](const Eigen::Vector2d& p) { return Traversable(p, std::min(need, robot.radius_m)); });
+    out.diag.advect_ms = NowMs() - t0;
+    if (PolylineLength(xy) < min_move || stuck) {
+      if (fallback()) {
+        std::vector<float> speeds(route_->polyline.size(), static_cast<float>(options_.speed_mps));
+        out.diag.mode = StepMode::kFrontier;
+        EmitLine(route_->polyline, speeds, robot, gain, &out);
+      }
+      return finish();
+    }
+    std::vector<float> speeds(xy.size(), static_cast<float>(options_.speed_mps));
+    out.diag.mode = StepMode::kAdvect;
+    EmitLine(xy, speeds, robot, gain, &out);
+    return finish();
+  }
+
   // Advection over the frames from the current sub-step (X4).
   const double adv_t0 = NowMs();
-  const double min_move = 0.5 * substep * options_.speed_mps;
   Pathline line = Advect(robot, robot.heading_rad, options_.lookahead_m, points);
   blocked_.Add(line);
   out.diag.stop = static_cast<int>(line.stop);

@@ -27,7 +27,12 @@ namespace voxplan::tensorfield {
 
 class ViewGain;  // gain.h
 
+// "tensor": the paper's planner; "harmonic": Shade & Newman 2011's gradient of a harmonic function
+// (X T3's baseline, harmonic.h), the same camera, fallback and termination.
+enum class Method : std::uint8_t { kTensor = 0, kHarmonic = 1 };
+
 struct PlannerOptions {
+  Method method = Method::kTensor;
   double substep_s = 0.4;         // X§6: 0.4 s sub-steps
   int substeps_per_keyframe = 5;  // Alg. 1 drives sub-steps K/2 .. K-1 of each key frame
   int frames_k = 10;              // K (X§6, Fig. 15)

@@ -29,6 +29,9 @@ PlannerOptions ReadOptions(const std::string& json_text) {
   o.speed_mps = json.Number("speed_mps", o.speed_mps, 0.05, 2.0);
   o.window_m = json.Number("window_m", o.window_m, 3.0, 30.0);
   o.interp_window_m = json.Number("interp_window_m", o.interp_window_m, 0.5, 30.0);
+  o.method = json.Choice("method", "tensor", {"tensor", "harmonic"}) == "harmonic"
+                 ? Method::kHarmonic
+                 : Method::kTensor;
   o.interp = json.Choice("interp", "spacetime", {"spacetime", "linear"}) == "linear"
                  ? InterpolationMode::kLinear
                  : InterpolationMode::kSpaceTime;
