@@ -170,15 +170,18 @@ std::vector<double> SeparatrixAngles(const Eigen::Matrix2d& jacobian, int scan_s
   return angles;
 }
 
-std::vector<DegeneratePoint> FindDegeneratePoints(const TensorRaster& field,
-                                                  const TopologyParams& params) {
-  std::vector<DegeneratePoint> points;
+namespace {
+
+// Calls found(x, y, cells, turns) for every 2x2 corner loop inside the domain around which the
+// angle of (a, b) winds by a non-zero number of turns (row by row: the output's order).
+template <typename Field, typename Found>
+void ForEachWindingLoop(const Field& field, const std::vector<double>& a,
+                        const std::vector<double>& b, const TopologyParams& params, Found found) {
   const omt::RasterGeometry& g = field.geometry;
   const std::size_t n = static_cast<std::size_t>(std::max(0, g.NumCells()));
-  if (field.tau11.size() != n || field.tau12.size() != n) return points;
-  if (!field.domain.empty() && field.domain.size() != n) return points;
-  const LoopData data = PerturbedAngles(field.tau11, field.tau12, field.domain);
-  const double res = g.resolution_m;
+  if (a.size() != n || b.size() != n) return;
+  if (!field.domain.empty() && field.domain.size() != n) return;
+  const LoopData data = PerturbedAngles(a, b, field.domain);
   for (int y = 0; y + 1 < g.height; ++y) {
     for (int x = 0; x + 1 < g.width; ++x) {
       const std::array<int, 4> cells = LoopCells(g, x, y);
@@ -186,23 +189,36 @@ std::vector<DegeneratePoint> FindDegeneratePoints(const TensorRaster& field,
         continue;
       }
       const double winding = LoopWinding(data, cells, params.min_relative_magnitude);
-      // 2θ winds by a multiple of 2π; ±2π (index ±1/2) is the generic case.
       const long turns = std::lround(winding / (2.0 * kPi));
-      if (turns == 0) continue;
-      DegeneratePoint p;
-      p.type = turns > 0 ? DegenerateType::kWedge : DegenerateType::kTrisector;
-      p.cell_x = x;
-      p.cell_y = y;
-      const Bilinear b{field.At(cells[0]), field.At(cells[1]), field.At(cells[3]),
-                       field.At(cells[2])};
-      Eigen::Vector2d uv(0.5, 0.5);
-      if (params.refine_position && !SolveZero(b, &uv)) uv = {0.5, 0.5};
-      p.position_m = g.Center(x, y) + res * uv;
-      p.jacobian = b.Jacobian(uv.x(), uv.y()) / res;
-      p.separatrix_angles_rad = SeparatrixAngles(p.jacobian, params.separatrix_scan_steps);
-      points.push_back(std::move(p));
+      if (turns != 0) found(x, y, cells, turns);
     }
   }
+}
+
+}  // namespace
+
+std::vector<DegeneratePoint> FindDegeneratePoints(const TensorRaster& field,
+                                                  const TopologyParams& params) {
+  std::vector<DegeneratePoint> points;
+  const omt::RasterGeometry& g = field.geometry;
+  const double res = g.resolution_m;
+  // 2θ winds by a multiple of 2π; ±2π (index ±1/2) is the generic case.
+  ForEachWindingLoop(field, field.tau11, field.tau12, params,
+                     [&](int x, int y, const std::array<int, 4>& cells, long turns) {
+                       DegeneratePoint p;
+                       p.type = turns > 0 ? DegenerateType::kWedge : DegenerateType::kTrisector;
+                       p.cell_x = x;
+                       p.cell_y = y;
+                       const Bilinear b{field.At(cells[0]), field.At(cells[1]), field.At(cells[3]),
+                                        field.At(cells[2])};
+                       Eigen::Vector2d uv(0.5, 0.5);
+                       if (params.refine_position && !SolveZero(b, &uv)) uv = {0.5, 0.5};
+                       p.position_m = g.Center(x, y) + res * uv;
+                       p.jacobian = b.Jacobian(uv.x(), uv.y()) / res;
+                       p.separatrix_angles_rad =
+                           SeparatrixAngles(p.jacobian, params.separatrix_scan_steps);
+                       points.push_back(std::move(p));
+                     });
   return points;
 }
 
@@ -210,27 +226,15 @@ std::vector<VectorSingularity> FindVectorSingularities(const VectorRaster& field
                                                        const TopologyParams& params) {
   std::vector<VectorSingularity> out;
   const omt::RasterGeometry& g = field.geometry;
-  const std::size_t n = static_cast<std::size_t>(std::max(0, g.NumCells()));
-  if (field.vx.size() != n || field.vy.size() != n) return out;
-  if (!field.domain.empty() && field.domain.size() != n) return out;
-  const LoopData data = PerturbedAngles(field.vx, field.vy, field.domain);
-  for (int y = 0; y + 1 < g.height; ++y) {
-    for (int x = 0; x + 1 < g.width; ++x) {
-      const std::array<int, 4> cells = LoopCells(g, x, y);
-      if (!std::all_of(cells.begin(), cells.end(), [&](int c) { return field.InDomain(c); })) {
-        continue;
-      }
-      const double winding = LoopWinding(data, cells, params.min_relative_magnitude);
-      const long turns = std::lround(winding / (2.0 * kPi));
-      if (turns == 0) continue;
-      VectorSingularity s;
-      s.index = static_cast<int>(turns);
-      s.cell_x = x;
-      s.cell_y = y;
-      s.position_m = g.Center(x, y) + 0.5 * g.resolution_m * Eigen::Vector2d::Ones();
-      out.push_back(s);
-    }
-  }
+  ForEachWindingLoop(
+      field, field.vx, field.vy, params, [&](int x, int y, const std::array<int, 4>&, long turns) {
+        VectorSingularity s;
+        s.index = static_cast<int>(turns);
+        s.cell_x = x;
+        s.cell_y = y;
+        s.position_m = g.Center(x, y) + 0.5 * g.resolution_m * Eigen::Vector2d::Ones();
+        out.push_back(s);
+      });
   return out;
 }
 
