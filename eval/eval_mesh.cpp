@@ -218,15 +218,19 @@ Result<MeshEvalResult> EvaluateMesh(const Mesh& reconstruction, const Mesh& grou
   const std::vector<double> coverage =
       SurfaceTree(std::move(*recon)).Distances(truth_samples, nullptr);
   const double threshold = double(params.threshold_m);
-  size_t covered = 0, covered_kept = 0;
+  size_t covered = 0, covered_kept = 0, below = 0, covered_below = 0;
   for (size_t i = 0; i < coverage.size(); ++i) {
+    const bool low = kept[i] && float(truth_samples[i].z()) <= params.below_z_m;
+    below += low;
     if (!(coverage[i] < threshold)) continue;
     ++covered;
     covered_kept += kept[i];
+    covered_below += low;
   }
   result.ground_truth_samples = kept_count;
   result.completeness = double(covered_kept) / double(kept_count);
   result.completeness_all = double(covered) / double(coverage.size());
+  result.completeness_below = below > 0 ? double(covered_below) / double(below) : 0.0;
   return result;
 }
 

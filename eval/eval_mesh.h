@@ -7,6 +7,7 @@
 #include <Eigen/Core>
 #include <cstdint>
 #include <functional>
+#include <limits>
 #include <memory>
 #include <string>
 #include <vector>
@@ -30,14 +31,18 @@ struct MeshEvalParams {
   uint64_t seed = 1;
   // Which ground-truth samples count for `completeness`; empty: all of them.
   PointSetFilter ground_truth_filter;
+  // Also `completeness_below`: over the kept samples at or below this height (Xu 2017's
+  // reference, the surface below the robot); +inf: every kept sample.
+  float below_z_m = std::numeric_limits<float>::infinity();
 };
 
 struct MeshEvalResult {
   double accuracy_mean_m = 0.0;
   double accuracy_rms_m = 0.0;
   double accuracy_median_m = 0.0;
-  double completeness = 0.0;      // 0..1, over the samples ground_truth_filter keeps
-  double completeness_all = 0.0;  // 0..1, over every ground-truth sample
+  double completeness = 0.0;        // 0..1, over the samples ground_truth_filter keeps
+  double completeness_all = 0.0;    // 0..1, over every ground-truth sample
+  double completeness_below = 0.0;  // 0..1, over the kept samples at or below below_z_m (0: none)
   double reconstruction_area_m2 = 0.0;
   double ground_truth_area_m2 = 0.0;
   size_t reconstruction_samples = 0;

@@ -587,6 +587,10 @@ Status Explorer::Advance(RobotRun& r, double t_end_s) {
       continue;
     }
     const float dh = WrapAngle(std::atan2(delta.y(), delta.x()) - s.heading_rad);
+    // The next straight piece towards the waypoint, at most a drive step.
+    const float piece = std::min(dist, p_.drive_step_m);
+    const Eigen::Vector2f goal =
+        piece < dist ? Eigen::Vector2f(s.position_W + delta * (piece / dist)) : r.route.front();
     // Continuous motion turns while it drives, the camera moving with it; a piece that would
     // drive backwards (more than a right angle off) turns in place first.
     if (q.continuous && std::abs(dh) <= 0.5f * kPi) {
@@ -594,9 +598,6 @@ Status Explorer::Advance(RobotRun& r, double t_end_s) {
       const float max_pitch = r.robot.max_abs_pitch_rad();
       const float speed = r.route_speed_mps.empty() ? r.robot.mode_params().max_speed_mps
                                                     : r.route_speed_mps.front();
-      const float piece = std::min(dist, p_.drive_step_m);
-      const Eigen::Vector2f goal =
-          piece < dist ? Eigen::Vector2f(s.position_W + delta * (piece / dist)) : r.route.front();
       if (Status st = r.robot.DriveAlong(
               goal, speed, s.camera_yaw_rad + WrapAngle(aim.yaw_rad - s.camera_yaw_rad),
               std::clamp(aim.pitch_rad, -max_pitch, max_pitch));
@@ -625,9 +626,6 @@ Status Explorer::Advance(RobotRun& r, double t_end_s) {
       VOXPLAN_RETURN_IF_ERROR(AfterPrimitive(r, c));
       continue;
     }
-    const float piece = std::min(dist, p_.drive_step_m);
-    const Eigen::Vector2f goal =
-        piece < dist ? Eigen::Vector2f(s.position_W + delta * (piece / dist)) : r.route.front();
     if (Status st = r.robot.DriveTo(goal); !st.ok()) {
       Blocked(r, q, goal, st);
       continue;

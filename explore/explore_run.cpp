@@ -121,23 +121,14 @@ Status Evaluate(const ExploreRunParams& params, const World& world, const FloorP
   ep.samples_per_m2 = float(params.eval_samples_per_m2);
   ep.seed = params.explore.seed;
   if (filter) ep.ground_truth_filter = filter;
+  // Xu 2017's reference (X L381): the observable surface below the robot's height, the floor
+  // map's band top; what lies above it, ceilings included, is left out.
+  ep.below_z_m = params.explore.floor.band_max_m;
   if (report.mesh.num_triangles() > 0) {
     Result<MeshEvalResult> q = EvaluateMesh(report.mesh, world.mesh, ep);
     if (!q.ok()) return q.status().Naming(params.scene);
     report.quality = *q;
-    // Xu 2017's reference (X L381): the observable surface below the robot's height, the floor
-    // map's band top; what lies above it, ceilings included, is left out.
-    MeshEvalParams low = ep;
-    const float cap_z = params.explore.floor.band_max_m;
-    low.ground_truth_filter = [&filter, cap_z](const std::vector<Eigen::Vector3f>& points) {
-      std::vector<uint8_t> keep =
-          filter ? filter(points) : std::vector<uint8_t>(points.size(), uint8_t(1));
-      for (size_t i = 0; i < points.size(); ++i) keep[i] &= uint8_t(points[i].z() <= cap_z);
-      return keep;
-    };
-    Result<MeshEvalResult> below = EvaluateMesh(report.mesh, world.mesh, low);
-    if (!below.ok()) return below.status().Naming(params.scene);
-    report.completeness_below_robot = below->completeness;
+    report.completeness_below_robot = q->completeness_below;
     if (HasObjects(world)) {
       ObjectEvalParams op;
       op.threshold_m = kObjectThreshold_m;

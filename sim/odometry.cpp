@@ -3,16 +3,11 @@
 #include <Eigen/Geometry>
 #include <cmath>
 
+#include "sim/split_mix.h"
+
 namespace voxplan {
 
 namespace {
-
-uint64_t SplitMix64(uint64_t x) {
-  x += 0x9e3779b97f4a7c15ull;
-  x = (x ^ (x >> 30)) * 0xbf58476d1ce4e5b9ull;
-  x = (x ^ (x >> 27)) * 0x94d049bb133111ebull;
-  return x ^ (x >> 31);
-}
 
 // Standard normal number k of (seed, stream) by Box-Muller over two 32-bit uniforms in (0, 1].
 double Normal(uint64_t seed, uint64_t stream, uint64_t k) {

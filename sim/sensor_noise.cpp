@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "core/parallel.h"
+#include "sim/split_mix.h"
 
 namespace voxplan {
 
@@ -18,13 +19,6 @@ namespace {
 // Counter-based randomness: every draw is a hash of (seed, frame, pixel, stream), so a pixel's
 // noise is the same whichever thread computes it. One 64-bit hash gives two 32-bit uniforms.
 enum Stream : uint64_t { kEdge = 0, kLateral = 1, kAxial = 2, kNumStreams = 3 };
-
-uint64_t SplitMix64(uint64_t x) {
-  x += 0x9e3779b97f4a7c15ull;
-  x = (x ^ (x >> 30)) * 0xbf58476d1ce4e5b9ull;
-  x = (x ^ (x >> 27)) * 0x94d049bb133111ebull;
-  return x ^ (x >> 31);
-}
 
 constexpr double kTwoPow32 = 4294967296.0;
 

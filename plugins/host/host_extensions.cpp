@@ -11,6 +11,15 @@
 namespace voxplan::internal {
 namespace {
 
+// Whether a struct of `size` bytes starting at `s` (a plugin's, maybe an older, shorter version)
+// holds `field`: fields past its end keep the host's defaults.
+template <typename S, typename F>
+bool HasField(const S& s, uint32_t size, const F& field) {
+  return size >=
+         uint32_t(reinterpret_cast<const char*>(&field) - reinterpret_cast<const char*>(&s)) +
+             uint32_t(sizeof(field));
+}
+
 // ---- vp.objects 1. ----------------------------------------------------------------------------
 
 vp_status GetInstanceSurface(const vp_world* w, uint32_t id, const vp_surface_voxel** out,
@@ -97,14 +106,9 @@ vp_status SetPathExt(vp_plan_output* o, uint32_t robot, const vp_path_point* poi
     plan.path_continuous = false;
     plan.path_speed_mps.clear();
     if (!ext) return VP_OK;
-    // Fields past what the plugin's struct holds keep their defaults.
-    const auto has = [&](const auto& field) {
-      return ext->struct_size >=
-             uint32_t(reinterpret_cast<const char*>(&field) - reinterpret_cast<const char*>(ext)) +
-                 uint32_t(sizeof(field));
-    };
-    if (has(ext->flags)) plan.path_continuous = (ext->flags & VP_PATH_CONTINUOUS) != 0;
-    if (has(ext->speed_mps) && ext->speed_mps) {
+    if (HasField(*ext, ext->struct_size, ext->flags))
+      plan.path_continuous = (ext->flags & VP_PATH_CONTINUOUS) != 0;
+    if (HasField(*ext, ext->struct_size, ext->speed_mps) && ext->speed_mps) {
       plan.path_speed_mps.assign(ext->speed_mps, ext->speed_mps + count);  // validated later
     }
     return VP_OK;
@@ -150,11 +154,7 @@ constexpr Extension kExtensions[] = {
 TaskCamera FromC(const vp_task_ext& e, uint32_t size) {
   TaskCamera c;
   // Fields past what the plugin's struct holds keep their defaults.
-  const auto has = [&](const auto& field) {
-    return size >=
-           uint32_t(reinterpret_cast<const char*>(&field) - reinterpret_cast<const char*>(&e)) +
-               uint32_t(sizeof(field));
-  };
+  const auto has = [&](const auto& field) { return HasField(e, size, field); };
   if (has(e.camera_height_m)) c.height_m = e.camera_height_m;
   if (has(e.camera_offset_m)) c.offset_m = {e.camera_offset_m[0], e.camera_offset_m[1]};
   if (has(e.look_at)) c.look_at = e.look_at != 0;

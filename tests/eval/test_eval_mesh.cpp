@@ -70,6 +70,35 @@ TEST(EvaluateMesh, HalfReconstructionIsHalfComplete) {
   EXPECT_NEAR(extra->accuracy_mean_m, 0.125, 0.01);
 }
 
+TEST(EvaluateMesh, CompletenessBelowCountsTheKeptSamplesUnderTheHeight) {
+  // Truth: a floor square at z = 0 and a ceiling square at z = 2; only the floor reconstructed.
+  Mesh truth = UnitSquare(0.f);
+  const Mesh ceiling = UnitSquare(2.f);
+  for (const auto& t : ceiling.triangles) truth.triangles.push_back({t[0] + 4, t[1] + 4, t[2] + 4});
+  truth.positions.insert(truth.positions.end(), ceiling.positions.begin(), ceiling.positions.end());
+  MeshEvalParams params;
+  params.threshold_m = 0.005f;
+  auto all = EvaluateMesh(UnitSquare(0.f), truth, params);  // below_z_m = +inf: every sample
+  ASSERT_TRUE(all.ok()) << all.status().message();
+  EXPECT_EQ(all->completeness_below, all->completeness);
+  EXPECT_NEAR(all->completeness, 0.5, kShareTolerance);
+  params.below_z_m = 1.8f;  // the floor only
+  auto low = EvaluateMesh(UnitSquare(0.f), truth, params);
+  ASSERT_TRUE(low.ok());
+  EXPECT_DOUBLE_EQ(low->completeness_below, 1.0);
+  EXPECT_EQ(low->completeness, all->completeness);  // the other figures do not change
+  // Kept and below together: the filter keeps x < 0.5, of the floor all is covered.
+  params.ground_truth_filter = KeepEach([](const Eigen::Vector3f& p) { return p.x() < 0.5f; });
+  auto both = EvaluateMesh(UnitSquare(0.f), truth, params);
+  ASSERT_TRUE(both.ok());
+  EXPECT_DOUBLE_EQ(both->completeness_below, 1.0);
+  // Nothing below: 0, not an error.
+  params.below_z_m = -1.f;
+  auto none = EvaluateMesh(UnitSquare(0.f), truth, params);
+  ASSERT_TRUE(none.ok());
+  EXPECT_EQ(none->completeness_below, 0.0);
+}
+
 TEST(EvaluateMesh, GroundTruthFilterRestrictsCompleteness) {
   MeshEvalParams params;
   params.threshold_m = 0.005f;
