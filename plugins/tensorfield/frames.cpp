@@ -43,11 +43,32 @@ FloorWindow CropFloor(const FloorInput& floor, const Eigen::Vector2d& centre_m, 
   return w;
 }
 
+namespace {
+
+TensorRaster Blend(FieldKind kind, const omt::RasterGeometry& geometry,
+                   std::span<const BoundarySample> samples, std::span<const std::uint8_t> domain,
+                   const KeyFrameParams& params) {
+  if (kind == FieldKind::kTensor) return BlendTensorField(geometry, samples, domain, params);
+  VectorRaster v = BlendVectorField(
+      geometry, samples, domain,
+      kind == FieldKind::kVectorNormal ? VectorConstraint::kNormal : VectorConstraint::kTangent,
+      params);
+  TensorRaster field;
+  field.geometry = v.geometry;
+  field.tau11 = std::move(v.vx);
+  field.tau12 = std::move(v.vy);
+  field.domain = std::move(v.domain);
+  return field;
+}
+
+}  // namespace
+
 TensorRaster WindowKeyFrame(const FloorWindow& window, const KeyFrameParams& params,
-                            const FillParams& fill, std::vector<BoundarySample>* samples_out) {
+                            const FillParams& fill, std::vector<BoundarySample>* samples_out,
+                            FieldKind kind) {
   std::vector<BoundarySample> samples = SampleBoundary(window.raster, params);
   const std::vector<std::uint8_t> domain = FieldDomain(window.raster, params.include_unknown);
-  TensorRaster field = BlendTensorField(window.geometry, samples, domain, params);
+  TensorRaster field = Blend(kind, window.geometry, samples, domain, params);
   if (fill.enabled && !samples.empty()) {
     // The wide blend on a coarse grid over the same extent (its cells' centres need not match).
     const int f = std::max(1, fill.coarse_factor);
@@ -59,7 +80,7 @@ TensorRaster WindowKeyFrame(const FloorWindow& window, const KeyFrameParams& par
         window.geometry.origin_m - 0.5 * coarse.resolution_m * Eigen::Vector2d::Ones();
     KeyFrameParams wide = params;
     wide.sigma_per_spacing *= fill.sigma_factor;
-    const TensorRaster broad = BlendTensorField(coarse, samples, {}, wide);
+    const TensorRaster broad = Blend(kind, coarse, samples, {}, wide);
     // Every cell the first blend may fill: the domain plus its value band.
     const std::vector<std::uint8_t> support =
         field.domain.empty() ? std::vector<std::uint8_t>{}

@@ -56,11 +56,19 @@ struct FillParams {
   int coarse_factor = 4;      // the wide blend's grid is this many cells coarser
 };
 
-// KeyFrameField on the window's raster (frontier counts as free) plus the fill.
-// samples_out (optional) receives the boundary samples.
+// What the key frame blends from the boundary samples: the paper's tensors, or the vector-field
+// baselines' unit normals or tangents (X Fig. 2). A vector field is kept in TensorRaster's two
+// components as (vx, vy): sampling, carry-over and both interpolations are component-wise, so the
+// baselines share the whole frame pipeline; only advection reads the components differently
+// (AdvectionParams::vector_field).
+enum class FieldKind : std::uint8_t { kTensor, kVectorNormal, kVectorTangent };
+
+// KeyFrameField (or the vector blend) on the window's raster (frontier counts as free) plus the
+// fill. samples_out (optional) receives the boundary samples.
 TensorRaster WindowKeyFrame(const FloorWindow& window, const KeyFrameParams& params,
                             const FillParams& fill,
-                            std::vector<BoundarySample>* samples_out = nullptr);
+                            std::vector<BoundarySample>* samples_out = nullptr,
+                            FieldKind kind = FieldKind::kTensor);
 
 // `field` on `geometry` (same resolution, origin on the same grid): cells both cover keep their
 // values and domain; the others take `fallback`'s (which must be on `geometry`).

@@ -56,12 +56,12 @@ double Sample(const omt::RasterGeometry& g, std::span<const double> phi, const E
 
 }  // namespace
 
-std::vector<Eigen::Vector2d> DescendHarmonic(const omt::RasterGeometry& g,
-                                             std::span<const double> phi,
-                                             std::span<const std::uint8_t> codes,
-                                             const Eigen::Vector2d& start, double length_m,
-                                             const std::function<bool(const Eigen::Vector2d&)>& ok,
-                                             const HarmonicParams& params) {
+std::vector<Eigen::Vector2d> DescendPotential(const omt::RasterGeometry& g,
+                                              std::span<const double> phi,
+                                              std::span<const std::uint8_t> codes,
+                                              const Eigen::Vector2d& start, double length_m,
+                                              const std::function<bool(const Eigen::Vector2d&)>& ok,
+                                              const HarmonicParams& params) {
   std::vector<Eigen::Vector2d> out = {start};
   if (g.NumCells() <= 0 || phi.size() != static_cast<std::size_t>(g.NumCells()) ||
       codes.size() != phi.size())

@@ -29,11 +29,11 @@ std::vector<double> SolveHarmonic(const omt::RasterGeometry& geometry,
 
 // Steepest descent of φ from start, at most length_m: stops on a frontier cell, where φ is flat
 // or where `ok` refuses the next point (blocked). Points from the start on, every step_m.
-std::vector<Eigen::Vector2d> DescendHarmonic(const omt::RasterGeometry& geometry,
-                                             std::span<const double> phi,
-                                             std::span<const std::uint8_t> codes,
-                                             const Eigen::Vector2d& start, double length_m,
-                                             const std::function<bool(const Eigen::Vector2d&)>& ok,
-                                             const HarmonicParams& params = {});
+std::vector<Eigen::Vector2d> DescendPotential(const omt::RasterGeometry& geometry,
+                                              std::span<const double> phi,
+                                              std::span<const std::uint8_t> codes,
+                                              const Eigen::Vector2d& start, double length_m,
+                                              const std::function<bool(const Eigen::Vector2d&)>& ok,
+                                              const HarmonicParams& params = {});
 
 }  // namespace voxplan::tensorfield

@@ -11,6 +11,7 @@
 #include "plugins/omt/algorithms/raster_ops.h"
 #include "plugins/tensorfield/gain.h"
 #include "plugins/tensorfield/harmonic.h"
+#include "plugins/tensorfield/potential_info.h"
 
 namespace voxplan::tensorfield {
 namespace {
@@ -86,7 +87,7 @@ void RobotPlanner::BuildKeyFrame(const FloorInput& floor, const RobotInput& robo
   window_ = CropFloor(floor, key_centre_, options_.window_m);
   const KeyFrameParams kp;
   std::vector<BoundarySample> samples;
-  TensorRaster next = WindowKeyFrame(window_, kp, options_.fill, &samples);
+  TensorRaster next = WindowKeyFrame(window_, kp, options_.fill, &samples, options_.field);
   const double t1 = NowMs();
   // The census of X Fig. 2 and 17 from the same constraints, before the fill: degenerate points
   // of the paper's blend against the singularities of the normal- and tangent-oriented vector
@@ -134,6 +135,8 @@ void RobotPlanner::BuildKeyFrame(const FloorInput& floor, const RobotInput& robo
 
 void RobotPlanner::BuildTopology(const RobotInput& robot, const ViewGain& gain, StepOutput* out) {
   const TensorRaster& frame = frames_[static_cast<std::size_t>(sub_)];
+  AddGlyphs(frame, out);
+  if (options_.field != FieldKind::kTensor) return;  // a vector field has no wedges or trisectors
   TopologyParams tp;
   tp.min_relative_magnitude = 1e-5;
   key_points_ = FindDegeneratePoints(frame, tp);
@@ -152,15 +155,26 @@ void RobotPlanner::BuildTopology(const RobotInput& robot, const ViewGain& gain, 
     return EdgeClear(e, window_.clearance, robot.radius_m);
   });
   for (const SkeletonEdge& e : skeleton_.edges) out->skeleton_edges.push_back(e.polyline);
+}
+
+// The field as glyphs for the run's picture: a segment along the major eigenvector (a vector
+// field: from the cell along the vector) every 0.4 m where the field is not flat.
+void RobotPlanner::AddGlyphs(const TensorRaster& frame, StepOutput* out) const {
   constexpr double kGlyphSpacingM = 0.4, kGlyphHalfM = 0.15;
+  const bool vector = options_.field != FieldKind::kTensor;
   const omt::RasterGeometry& g = frame.geometry;
   const int step = std::max(1, static_cast<int>(std::lround(kGlyphSpacingM / g.resolution_m)));
   for (int y = step / 2; y < g.height; y += step)
     for (int x = step / 2; x < g.width; x += step) {
       const int i = g.Index(x, y);
       if (!frame.InDomain(i) || frame.At(i).norm() <= min_magnitude_) continue;
-      const Eigen::Vector2d c = g.Center(x, y), d = kGlyphHalfM * MajorEigenvector(frame.At(i));
-      out->field_glyphs.push_back({c - d, c + d});
+      const Eigen::Vector2d c = g.Center(x, y);
+      if (vector) {
+        out->field_glyphs.push_back({c, c + 2.0 * kGlyphHalfM * frame.At(i).normalized()});
+      } else {
+        const Eigen::Vector2d d = kGlyphHalfM * MajorEigenvector(frame.At(i));
+        out->field_glyphs.push_back({c - d, c + d});
+      }
     }
 }
 
@@ -175,6 +189,7 @@ Pathline RobotPlanner::Advect(const RobotInput& robot, double heading_rad, doubl
   ap.block_clearance_m = robot.radius_m + options_.clearance_margin_m;
   ap.wall_clearance_m = std::max(0.3, ap.block_clearance_m + 0.05);
   ap.stop_at_wedges = ap.stop_at_trisectors = true;
+  ap.vector_field = options_.field != FieldKind::kTensor;
   // A robot already closer to a wall than its radius (a bump) may still move along or away.
   const int c = window_.geometry.IndexOf(robot.position_m);
   const double start_clearance = c >= 0 ? window_.clearance.At(c) : 0.0;
@@ -421,7 +436,9 @@ StepOutput RobotPlanner::Step(const FloorInput& floor, const RobotInput& robot, 
   TopologyParams tp;
   tp.min_relative_magnitude = 1e-5;
   const std::vector<DegeneratePoint> points =
-      FindDegeneratePoints(frames_[static_cast<std::size_t>(sub_)], tp);
+      options_.field == FieldKind::kTensor
+          ? FindDegeneratePoints(frames_[static_cast<std::size_t>(sub_)], tp)
+          : std::vector<DegeneratePoint>{};
   out.diag.topology_ms = NowMs() - topo_t0;
   out.diag.degenerate_points = static_cast<int>(points.size());
   for (const DegeneratePoint& p : points) {
@@ -494,12 +511,18 @@ StepOutput RobotPlanner::Step(const FloorInput& floor, const RobotInput& robot, 
 
   const double min_move = 0.5 * substep * options_.speed_mps;
   if (!tensor) {
-    // The harmonic baseline: down φ over the window around the robot, every call anew.
+    // The potential baselines: down φ over the window around the robot, every call anew.
     const double t0 = NowMs();
     const FloorWindow w = CropFloor(floor, robot.position_m, options_.window_m);
-    const std::vector<double> phi = SolveHarmonic(w.geometry, w.codes);
+    PotentialInfoParams pp;
+    pp.sigma_m = 0.5 * robot.max_range_m;
+    pp.repulse_within_m = robot.radius_m + 0.3;
+    const std::vector<double> phi =
+        options_.method == Method::kHarmonic
+            ? SolveHarmonic(w.geometry, w.codes)
+            : SolvePotentialInfo(w.geometry, w.codes, w.clearance.clearance_m, pp);
     const double need = robot.radius_m + options_.clearance_margin_m;
-    const std::vector<Eigen::Vector2d> xy = DescendHarmonic(
+    const std::vector<Eigen::Vector2d> xy = DescendPotential(
         w.geometry, phi, w.codes, robot.position_m,
         options_.sent_substeps * substep * options_.speed_mps,
         [&](const Eigen::Vector2d& p) { return Traversable(p, std::min(need, robot.radius_m)); });

@@ -27,12 +27,17 @@ namespace voxplan::tensorfield {
 
 class ViewGain;  // gain.h
 
-// "tensor": the paper's planner; "harmonic": Shade & Newman 2011's gradient of a harmonic function
-// (X T3's baseline, harmonic.h), the same camera, fallback and termination.
-enum class Method : std::uint8_t { kTensor = 0, kHarmonic = 1 };
+// "tensor": the paper's planner; X T3's baselines, with the same camera, fallback and
+// termination: "harmonic", Shade & Newman 2011's gradient of a harmonic function (harmonic.h);
+// "potential", a potential information field with wall repulsion in Vallvé's style
+// (potential_info.h).
+enum class Method : std::uint8_t { kTensor = 0, kHarmonic = 1, kPotential = 2 };
 
 struct PlannerOptions {
   Method method = Method::kTensor;
+  // With kTensor: the paper's tensor field, or a vector-field baseline from the same constraints
+  // (X Fig. 2), advected with its sign and without degenerate points, skeleton or routing.
+  FieldKind field = FieldKind::kTensor;
   double substep_s = 0.4;         // X§6: 0.4 s sub-steps
   int substeps_per_keyframe = 5;  // Alg. 1 drives sub-steps K/2 .. K-1 of each key frame
   int frames_k = 10;              // K (X§6, Fig. 15)
@@ -154,6 +159,7 @@ class RobotPlanner {
 
   void BuildKeyFrame(const FloorInput& floor, const RobotInput& robot, double t_s, StepOutput* out);
   void BuildTopology(const RobotInput& robot, const ViewGain& gain, StepOutput* out);
+  void AddGlyphs(const TensorRaster& frame, StepOutput* out) const;
   Pathline Advect(const RobotInput& robot, double heading_rad, double length_m,
                   const std::vector<DegeneratePoint>& points) const;
   bool Traversable(const Eigen::Vector2d& p, double radius_m) const;

@@ -29,9 +29,10 @@ PlannerOptions ReadOptions(const std::string& json_text) {
   o.speed_mps = json.Number("speed_mps", o.speed_mps, 0.05, 2.0);
   o.window_m = json.Number("window_m", o.window_m, 3.0, 30.0);
   o.interp_window_m = json.Number("interp_window_m", o.interp_window_m, 0.5, 30.0);
-  o.method = json.Choice("method", "tensor", {"tensor", "harmonic"}) == "harmonic"
-                 ? Method::kHarmonic
-                 : Method::kTensor;
+  const std::string method = json.Choice("method", "tensor", {"tensor", "harmonic", "potential"});
+  o.method = method == "harmonic"    ? Method::kHarmonic
+             : method == "potential" ? Method::kPotential
+                                     : Method::kTensor;
   o.interp = json.Choice("interp", "spacetime", {"spacetime", "linear"}) == "linear"
                  ? InterpolationMode::kLinear
                  : InterpolationMode::kSpaceTime;
@@ -45,11 +46,13 @@ PlannerOptions ReadOptions(const std::string& json_text) {
   o.gain_threshold = json.Number("gain_threshold", o.gain_threshold, 0.0, 1.0);
   const std::string field =
       json.Choice("field", "tensor", {"tensor", "vector_normal", "vector_tangent"});
-  if (field != "tensor")
+  o.field = field == "vector_normal"    ? FieldKind::kVectorNormal
+            : field == "vector_tangent" ? FieldKind::kVectorTangent
+                                        : FieldKind::kTensor;
+  if (o.field != FieldKind::kTensor && o.method != Method::kTensor)
     throw vp::Error(VP_ERROR_INVALID_ARGUMENT,
-                    "tensorfield: field \"" + field +
-                        "\" is not implemented yet (only \"tensor\"; the vector-field baselines "
-                        "are listed as not done in plugins/tensorfield/README.md)");
+                    "tensorfield: field \"" + field + "\" needs method \"tensor\" (the method \"" +
+                        method + "\" has its own potential and no field)");
   o.clearance_margin_m = json.Number("clearance_margin_m", o.clearance_margin_m, 0.0, 1.0);
   o.lookahead_m = json.Number("lookahead_m", o.lookahead_m, 0.3, 10.0);
   o.fill.enabled = json.Flag("fill", o.fill.enabled);

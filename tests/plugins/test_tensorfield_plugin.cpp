@@ -85,16 +85,21 @@ TEST(Tensorfield, LoadsWithDefaultsAndRefusesUnknownKeysAndBadValues) {
   for (const char* bad : {R"({"substeps": 5})", R"({"substep_s": 0})", R"({"speed_mps": 5})",
                           R"({"interp": "cubic"})", R"({"camera": "free"})", R"({"frames_k": 1})",
                           R"({"substeps_per_keyframe": 11})", R"({"gain_threshold": -1})",
-                          R"({"topology_routing": "yes"})", R"({"field": "vector_normal"})"}) {
+                          R"({"topology_routing": "yes"})", R"({"field": "vector_radial"})",
+                          R"({"method": "gradient"})"}) {
     PlannerLoadOptions o;
     o.config_json = bad;
     EXPECT_FALSE(LoadPlanner("tensorfield", o).ok()) << bad;
   }
+  for (const char* good : {R"({"field": "vector_normal"})", R"({"field": "vector_tangent"})",
+                           R"({"method": "potential"})", R"({"method": "harmonic"})"})
+    EXPECT_TRUE(Load(good)) << good;
+  // A vector field belongs to the tensor method's pipeline; the potential methods have none.
   PlannerLoadOptions o;
-  o.config_json = R"({"field": "vector_tangent"})";
+  o.config_json = R"({"field": "vector_tangent", "method": "potential"})";
   auto refused = LoadPlanner("tensorfield", o);
   ASSERT_FALSE(refused.ok());
-  EXPECT_NE(refused.status().message().find("not implemented"), std::string::npos)
+  EXPECT_NE(refused.status().message().find("needs method"), std::string::npos)
       << refused.status().message();
 }
 

@@ -18,6 +18,9 @@ constexpr double kArcSlack_m = 1e-9;
 struct FieldAt {
   std::span<const TensorRaster> frames;
   double spacing_m = 0.0;
+  // AdvectionParams::vector_field: the components are a vector, followed with this sign.
+  bool vector = false;
+  double sign = 1.0;
 
   // Frame index at or before s, and the blend weight of the next one.
   std::pair<std::size_t, double> Locate(double s_m) const {
@@ -40,6 +43,10 @@ struct FieldAt {
                                            const Eigen::Vector2d& reference) const {
     const std::optional<Eigen::Vector2d> tau = Sample(p_m, s_m);
     if (!tau) return std::nullopt;
+    if (vector) {
+      const double n = tau->norm();
+      return n > 0.0 ? Eigen::Vector2d(sign * *tau / n) : Eigen::Vector2d::Zero();
+    }
     Eigen::Vector2d e = MajorEigenvector(*tau);
     if (e.dot(reference) < 0.0) e = -e;
     return e;
@@ -121,14 +128,21 @@ void FillHeadings(std::vector<PathPoint>* points, double start_heading) {
   }
 }
 
-Pathline Advect(const FieldAt& field, const Eigen::Vector2d& start_m, double heading_rad,
+Pathline Advect(FieldAt field, const Eigen::Vector2d& start_m, double heading_rad,
                 std::span<const DegeneratePoint> degenerate, const AdvectionParams& params,
                 const AdvectionObstacles& obstacles) {
   Pathline line;
-  if (field.frames.empty() || !field.Sample(start_m, 0.0)) {
+  const std::optional<Eigen::Vector2d> at_start =
+      field.frames.empty() ? std::nullopt : field.Sample(start_m, 0.0);
+  if (!at_start) {
     line.stop = AdvectionStop::kLeftDomain;
     return line;
   }
+  field.vector = params.vector_field;
+  if (field.vector)
+    field.sign = at_start->dot(Eigen::Vector2d(std::cos(heading_rad), std::sin(heading_rad))) < 0.0
+                     ? -1.0
+                     : 1.0;
   const double threshold = params.min_magnitude >= 0.0
                                ? params.min_magnitude
                                : params.min_relative_magnitude * MaxFieldMagnitude(field.frames[0]);
@@ -309,7 +323,7 @@ double MaxFieldMagnitude(const TensorRaster& field) {
 std::optional<Eigen::Vector2d> OrientedDirection(const TensorRaster& field,
                                                  const Eigen::Vector2d& p_m,
                                                  const Eigen::Vector2d& reference) {
-  const FieldAt f{std::span<const TensorRaster>(&field, 1), 0.0};
+  const FieldAt f{std::span<const TensorRaster>(&field, 1), 0.0, false, 1.0};
   return f.Direction(p_m, 0.0, reference);
 }
 
@@ -326,15 +340,15 @@ double SpeedBeforeWedge(double s_m, double wedge_arc_m, const AdvectionParams& p
 Pathline AdvectPathline(const TensorRaster& field, const Eigen::Vector2d& start_m,
                         double heading_rad, std::span<const DegeneratePoint> degenerate_points,
                         const AdvectionParams& params, const AdvectionObstacles& obstacles) {
-  return Advect(FieldAt{std::span<const TensorRaster>(&field, 1), 0.0}, start_m, heading_rad,
-                degenerate_points, params, obstacles);
+  return Advect(FieldAt{std::span<const TensorRaster>(&field, 1), 0.0, false, 1.0}, start_m,
+                heading_rad, degenerate_points, params, obstacles);
 }
 
 Pathline AdvectPathline(std::span<const TensorRaster> frames, const Eigen::Vector2d& start_m,
                         double heading_rad, std::span<const DegeneratePoint> degenerate_points,
                         const AdvectionParams& params, const AdvectionObstacles& obstacles) {
-  return Advect(FieldAt{frames, params.frame_spacing_m}, start_m, heading_rad, degenerate_points,
-                params, obstacles);
+  return Advect(FieldAt{frames, params.frame_spacing_m, false, 1.0}, start_m, heading_rad,
+                degenerate_points, params, obstacles);
 }
 
 }  // namespace voxplan::tensorfield

@@ -97,6 +97,12 @@ struct AdvectionParams {
   // consecutive frames (one sub-step: 0.4 s × 0.3 m/s); the field at arc length s is the linear
   // blend of frames floor(s / spacing) and the next, the last frame beyond the sequence.
   double frame_spacing_m = 0.12;
+
+  // The vector-field baselines (X Fig. 2): the raster's two components are a vector (vx, vy), not
+  // (τ11, τ12). The line follows the vector itself, or its opposite when that agrees better with
+  // the start heading; the choice holds for the whole line (a vector field has a sign, so unlike
+  // the line field it is not re-oriented along the way and runs into its sinks).
+  bool vector_field = false;
 };
 
 struct PathPoint {

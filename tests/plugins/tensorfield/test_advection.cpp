@@ -70,6 +70,35 @@ TEST(Advection, UniformFieldGoesStraightAtTheStepAndLength) {
   }
 }
 
+// The vector-field baselines (AdvectionParams::vector_field): the components are a vector, its
+// sign chosen once from the heading; a sink (vectors converging from both sides, the normals of
+// two facing walls) stops the line where the field cancels.
+TEST(Advection, VectorFieldKeepsItsSignAndRunsIntoASink) {
+  const TensorRaster uniform =
+      test::AnalyticField(80, 80, [](const Eigen::Vector2d&) { return Eigen::Vector2d(1.0, 0.0); });
+  AdvectionParams params;
+  params.vector_field = true;
+  params.max_length_m = 1.0;
+  for (double heading : {0.4, kPi - 0.4}) {
+    const Pathline line = AdvectPathline(uniform, {2.0, 2.0}, heading, {}, params);
+    ASSERT_EQ(line.stop, AdvectionStop::kLength);
+    const double sign = std::cos(heading) > 0.0 ? 1.0 : -1.0;
+    EXPECT_NEAR(line.points.back().position_m.x() - 2.0, sign * 1.0, 1e-9);
+    EXPECT_NEAR(line.points.back().position_m.y(), 2.0, 1e-9);
+  }
+  // Normals of walls at y = 0 and y = 4 m: (0, 1) below the mid line, (0, -1) above, cancelling
+  // at y = 2. From y = 1 heading up the line stops at the mid line, within one step.
+  const TensorRaster sink = test::AnalyticField(80, 80, [](const Eigen::Vector2d& p) {
+    return Eigen::Vector2d(0.0, std::tanh(4.0 * (2.0 - p.y())));
+  });
+  params.max_length_m = 3.0;
+  params.min_magnitude = 1e-3;
+  const Pathline into = AdvectPathline(sink, {2.0, 1.0}, 0.5 * kPi, {}, params);
+  EXPECT_EQ(into.stop, AdvectionStop::kDegenerate);
+  EXPECT_NEAR(into.points.back().position_m.y(), 2.0, 0.05);
+  EXPECT_LT(into.Length(), 1.05);
+}
+
 TEST(Advection, CircularFieldIsFollowedAlongTheCircle) {
   const Eigen::Vector2d c(2.0, 2.0);
   // θ = polar angle + 90°: the major eigenvectors are tangent to circles around c.

@@ -5,6 +5,7 @@
 
 #include "plugins/tensorfield/frames.h"
 #include "plugins/tensorfield/harmonic.h"
+#include "plugins/tensorfield/potential_info.h"
 
 namespace voxplan::tensorfield {
 namespace {
@@ -55,13 +56,13 @@ TEST(Harmonic, PotentialIsBoundedWithoutLocalMinimaAndDescendsToTheFrontier) {
   // From the closed end along the corridor's axis: eastwards, downhill, to the frontier.
   const Eigen::Vector2d start(0.2, 0.25);
   const std::vector<Eigen::Vector2d> path =
-      DescendHarmonic(c.g, phi, c.codes, start, 5.0, [](const Eigen::Vector2d&) { return true; });
+      DescendPotential(c.g, phi, c.codes, start, 5.0, [](const Eigen::Vector2d&) { return true; });
   ASSERT_GT(path.size(), 10u);
   EXPECT_NEAR(path.back().x(), 2.95, 0.06);  // in the frontier column
   EXPECT_NEAR(path.back().y(), 0.25, 0.05);  // on the axis (the corridor is symmetric)
   for (std::size_t i = 1; i < path.size(); ++i) EXPECT_GT(path[i].x(), path[i - 1].x());
   // Refused beyond x = 1 m: stops there.
-  const std::vector<Eigen::Vector2d> stopped = DescendHarmonic(
+  const std::vector<Eigen::Vector2d> stopped = DescendPotential(
       c.g, phi, c.codes, start, 5.0, [](const Eigen::Vector2d& p) { return p.x() < 1.0; });
   EXPECT_LT(stopped.back().x(), 1.0);
   EXPECT_GT(stopped.back().x(), 0.9);
@@ -72,9 +73,47 @@ TEST(Harmonic, NoFrontierNoWayDown) {
   for (std::uint8_t& code : c.codes)
     if (code == kFloorFrontier) code = kFloorObstacle;
   const std::vector<double> phi = SolveHarmonic(c.g, c.codes);
-  const std::vector<Eigen::Vector2d> path = DescendHarmonic(
+  const std::vector<Eigen::Vector2d> path = DescendPotential(
       c.g, phi, c.codes, {1.0, 0.25}, 2.0, [](const Eigen::Vector2d&) { return true; });
   EXPECT_EQ(path.size(), 1u);  // φ is 1 everywhere: flat
+}
+
+// The potential information field (potential_info.h): unknown space attracts, walls repel.
+TEST(PotentialInfo, AttractsTowardsTheUnknownEndAndRepelsFromTheWalls) {
+  Corridor c;
+  // The east end unknown instead of frontier (the potential counts both as information).
+  for (std::uint8_t& code : c.codes)
+    if (code == kFloorFrontier) code = kFloorUnknown;
+  std::vector<float> clearance(c.codes.size());
+  for (int i = 0; i < c.g.NumCells(); ++i) {
+    const double y = c.g.Center(i).y();
+    clearance[static_cast<std::size_t>(i)] =
+        static_cast<float>(std::min(y - 0.025, c.g.height * c.g.resolution_m - 0.025 - y));
+  }
+  PotentialInfoParams pp;
+  pp.sigma_m = 1.0;
+  pp.repulse_within_m = 0.1;
+  const std::vector<double> phi = SolvePotentialInfo(c.g, c.codes, clearance, pp);
+  ASSERT_EQ(phi.size(), c.codes.size());
+  // Lower (more attractive) towards the unknown east end along the axis.
+  const auto at = [&](double x, double y) {
+    return phi[static_cast<std::size_t>(c.g.IndexOf({x, y}))];
+  };
+  EXPECT_LT(at(2.5, 0.25), at(1.5, 0.25));
+  EXPECT_LT(at(1.5, 0.25), at(0.5, 0.25));
+  // Repelled from the wall: at the same x, the axis is lower than next to the wall.
+  EXPECT_LT(at(1.5, 0.25), at(1.5, 0.075));
+  // The descent runs east and keeps off the walls.
+  const std::vector<Eigen::Vector2d> path = DescendPotential(
+      c.g, phi, c.codes, {0.3, 0.25}, 2.0, [](const Eigen::Vector2d&) { return true; });
+  ASSERT_GT(path.size(), 10u);
+  EXPECT_GT(path.back().x(), 1.5);
+  for (const Eigen::Vector2d& p : path) EXPECT_NEAR(p.y(), 0.25, 0.06);
+  // Nothing unknown: no attraction, only the walls' repulsion (zero on the axis band).
+  for (std::uint8_t& code : c.codes)
+    if (code == kFloorUnknown) code = kFloorObstacle;
+  const std::vector<double> flat = SolvePotentialInfo(c.g, c.codes, clearance, pp);
+  EXPECT_EQ(flat[static_cast<std::size_t>(c.g.IndexOf({1.5, 0.25}))], 0.0);
 }
 
 }  // namespace
