@@ -322,12 +322,35 @@ std::vector<RunTimePoint> RunTimeSeries(const std::vector<RobotTrack>& tracks) {
 
 Status WriteRunTimeSeriesCsv(const std::vector<RunTimePoint>& series, const std::string& path) {
   const auto field = [](double v) { return std::isfinite(v) ? FormatDouble(v) : std::string(); };
-  std::string text = "t,distance_total_m,busy_robots,coverage,completeness\n";
+  std::string text =
+      "t,distance_total_m,busy_robots,coverage,completeness,unobserved_m3,mean_uncertainty\n";
   for (const RunTimePoint& p : series) {
     text += field(p.t_s) + ',' + field(p.distance_total_m) + ',' + std::to_string(p.busy_robots) +
-            ',' + field(p.coverage) + ',' + field(p.completeness) + '\n';
+            ',' + field(p.coverage) + ',' + field(p.completeness) + ',' + field(p.unobserved_m3) +
+            ',' + field(p.mean_uncertainty) + '\n';
   }
   return WriteFileAtomically(path, text);
+}
+
+double UnobservedAreaFraction(const std::vector<RunTimePoint>& series, double horizon_s) {
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  const RunTimePoint* last = nullptr;
+  double t0 = 0.0, u0 = 0.0, area = 0.0;
+  for (const RunTimePoint& p : series) {
+    if (!std::isfinite(p.unobserved_m3)) continue;
+    if (!last) {
+      t0 = p.t_s;
+      u0 = p.unobserved_m3;
+    } else {
+      area += 0.5 * (last->unobserved_m3 + p.unobserved_m3) * (p.t_s - last->t_s);
+    }
+    last = &p;
+  }
+  if (!last || !(u0 > 0.0)) return nan;
+  const double end_s = std::max(horizon_s, last->t_s);
+  if (!(end_s > t0)) return nan;
+  area += last->unobserved_m3 * (end_s - last->t_s);
+  return area / (u0 * (end_s - t0));
 }
 
 }  // namespace voxplan

@@ -123,13 +123,27 @@ struct RunTimePoint {
   int busy_robots = 0;
   double coverage = std::numeric_limits<double>::quiet_NaN();      // 0..1, FloorCoverage
   double completeness = std::numeric_limits<double>::quiet_NaN();  // 0..1, EvaluateMesh
+  // The scene's interior not yet observed in the planning map, m³ (the explorer's definition:
+  // explore/explore.h), and the mean uncertainty of its surface voxels, 0..1 (NaN: none yet).
+  double unobserved_m3 = std::numeric_limits<double>::quiet_NaN();
+  double mean_uncertainty = std::numeric_limits<double>::quiet_NaN();
 };
 
 // Distance and busy robots at every distinct sample time of the log (coverage and completeness
 // NaN: the explorer fills them in from its maps).
 std::vector<RunTimePoint> RunTimeSeries(const std::vector<RobotTrack>& tracks);
 
-// CSV with header `t,distance_total_m,busy_robots,coverage,completeness`.
+// CSV with header `t,distance_total_m,busy_robots,coverage,completeness,unobserved_m3,
+// mean_uncertainty` (the last two since the unobserved-volume curve; a reader takes columns by
+// name, so files without them still read).
 Status WriteRunTimeSeriesCsv(const std::vector<RunTimePoint>& series, const std::string& path);
+
+// The area under the unobserved-volume curve as a share of never observing anything more: the
+// integral of unobserved_m3 from the first point with a value to horizon_s (linear between
+// points, held at the last value after it: a run that ended early observes nothing more) over
+// that first value times the span. 0 would be everything observed at once, 1 nothing after the
+// start; a fixed horizon (the run's time limit) makes runs that end at different times
+// comparable. NaN without a positive first value or a span.
+double UnobservedAreaFraction(const std::vector<RunTimePoint>& series, double horizon_s);
 
 }  // namespace voxplan

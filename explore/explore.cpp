@@ -19,6 +19,7 @@
 #include "explore/explore_world.h"
 #include "fusion/integrate.h"
 #include "planning/integrate_planning.h"
+#include "planning/map_summary.h"
 #include "sim/raycaster.h"
 #include "sim/sensor_noise.h"
 
@@ -71,6 +72,10 @@ struct RobotRun {
   std::deque<float> route_speed_mps;  // a continuous task's speed per waypoint (else empty)
   std::vector<CameraSample> camera_trajectory;
   double trajectory_t0_s = 0.0;
+  // Continuous pieces driven since the trajectory was given, each at its length over its speed:
+  // the trajectory's time for the distance driven along the path (ArmTarget), whatever the
+  // pieces really took.
+  double path_s = 0.0;
   double t_s = 0.0;  // this robot's time on the run clock (its Robot clock plus waiting)
   bool idle = false;
   double next_capture_s = 0.0;  // time-based capture (ModeParams::capture_hz): the next frame
@@ -94,6 +99,38 @@ struct Failure {
   size_t robot = 0;
   PlannerTask task;
 };
+
+// The scene's interior for the unobserved-volume curve (RunTimePoint::unobserved_m3): the
+// planning map's voxels whose centre lies over a cell of the true plan with a floor (free or
+// obstacle, FloorArea's cells) and between the floor and the floor map's band top (the robot's
+// height, where completeness_below_robot stops too). Fixed for the run, so the curve only falls:
+// fused weights never decrease, so an observed voxel stays observed. Wall and furniture cores
+// are in it and are never observed, so it levels off above zero.
+ColumnRegion InteriorRegion(const FloorPlan& plan, const ExploreParams& p) {
+  const double s = p.voxel_size_m;
+  std::vector<Eigen::Vector2i> columns;
+  if (plan.width > 0 && plan.height > 0) {
+    const Eigen::Vector2d lo = plan.origin_W.cast<double>() / s;
+    const Eigen::Vector2d hi =
+        (plan.origin_W.cast<double>() +
+         double(plan.resolution_m) * Eigen::Vector2d(plan.width, plan.height)) /
+        s;
+    for (int iy = int(std::floor(lo.y())); iy <= int(std::floor(hi.y())); ++iy)
+      for (int ix = int(std::floor(lo.x())); ix <= int(std::floor(hi.x())); ++ix) {
+        const Eigen::Vector2d cell =
+            ((Eigen::Vector2d(ix, iy).array() + 0.5) * s - plan.origin_W.cast<double>().array()) /
+            double(plan.resolution_m);
+        const int cx = int(std::floor(cell.x())), cy = int(std::floor(cell.y()));
+        if (plan.Contains(cx, cy) && plan.at(cx, cy) != PlanCell::kOutside)
+          columns.emplace_back(ix, iy);
+      }
+  }
+  // Voxel z has its centre at (z + 0.5) s.
+  const double floor_z = p.floor.floor_z_m, top_z = floor_z + double(p.floor.band_max_m);
+  const int z_begin = int(std::ceil(floor_z / s - 0.5)),
+            z_end = int(std::floor(top_z / s - 0.5)) + 1;
+  return ColumnRegion(columns, z_begin, z_end);
+}
 
 class Explorer {
  public:
@@ -143,6 +180,13 @@ class Explorer {
   void Record(bool with_completeness);
   double DistanceTotal() const;
   CameraAim CameraTarget(const RobotRun& r) const;
+  struct ArmAim {
+    Eigen::Vector3f offset_B;  // RobotState::camera_offset_B, in the workspace
+    std::string clamped;       // why the trajectory's position was moved into it; empty: it was not
+  };
+  std::optional<ArmAim> ArmTarget(const RobotRun& r, const Eigen::Vector2f& goal_W,
+                                  float heading_rad, double path_s) const;
+  void CountArmClamps(const RobotRun& r, const ArmAim& aim);
 
   const World& world_;
   const FloorPlan& plan_;
@@ -156,6 +200,7 @@ class Explorer {
   PlanningMap map_;
   std::unique_ptr<FloorMap> floor_;
   ExploreWorld explore_world_;
+  std::optional<ColumnRegion> interior_;  // the unobserved-volume curve's (InteriorRegion)
   std::vector<RobotRun> robots_;
   std::vector<uint8_t> structure_by_id_;  // world instance id -> scene structure (detector)
   std::vector<BlockIndex> touched_;       // since the last floor-map update
@@ -440,6 +485,24 @@ std::pair<float, float> TrajectoryYawPitch(const std::vector<CameraSample>& tr, 
   return {tr.back().yaw_rad, tr.back().pitch_rad};
 }
 
+// The trajectory's camera position t seconds after it was given, keyed and interpolated as
+// TrajectoryYawPitch; nullopt where a sample it reads has none (NaN).
+std::optional<Eigen::Vector3f> TrajectoryPosition(const std::vector<CameraSample>& tr, float t) {
+  const auto known = [](const CameraSample& s) -> std::optional<Eigen::Vector3f> {
+    if (!s.position_m.allFinite()) return std::nullopt;
+    return s.position_m;
+  };
+  if (t <= tr.front().t_s) return known(tr.front());
+  for (size_t i = 1; i < tr.size(); ++i) {
+    if (t > tr[i].t_s) continue;
+    if (!known(tr[i - 1]) || !known(tr[i])) return std::nullopt;
+    const float span = tr[i].t_s - tr[i - 1].t_s;
+    const float a = span > 0.f ? (t - tr[i - 1].t_s) / span : 1.f;
+    return Eigen::Vector3f(tr[i - 1].position_m + a * (tr[i].position_m - tr[i - 1].position_m));
+  }
+  return known(tr.back());
+}
+
 // The camera yaw (relative to the base) and pitch that aim from the robot's camera at a point.
 CameraAim AimAt(const Robot& robot, const Eigen::Vector3f& target_W) {
   const Eigen::Vector3f d = target_W - robot.T_W_C().translation();
@@ -464,6 +527,47 @@ CameraAim Explorer::CameraTarget(const RobotRun& r) const {
   const float max_pitch = r.robot.max_abs_pitch_rad();
   return {WrapAngle(world_yaw - r.robot.state().heading_rad),
           std::clamp(pitch, -max_pitch, max_pitch)};
+}
+
+// On an arm mount, where the camera trajectory puts the camera as a piece of continuous motion
+// ends: its position at `path_s`, the path's time at its speeds up to the piece's end, in the base
+// frame of the pose the piece ends at, moved into the workspace. The samples' t_s is time along
+// the path at its speeds, so this keys the positions by arc length along the base path (Xu
+// 2017's camera path): a base held up by its turns or camera joints (the first piece turning the
+// camera round from the start sweep) does not leave the camera running ahead. Yaw and pitch keep
+// the run clock at the piece's start, as they always did. nullopt on a head, without a trajectory
+// or where it gives no position.
+std::optional<Explorer::ArmAim> Explorer::ArmTarget(const RobotRun& r,
+                                                    const Eigen::Vector2f& goal_W,
+                                                    float heading_rad, double path_s) const {
+  const ModeParams& m = r.robot.mode_params();
+  if (m.mount != MountKind::kArm || r.camera_trajectory.empty()) return std::nullopt;
+  const std::optional<Eigen::Vector3f> p_W = TrajectoryPosition(r.camera_trajectory, float(path_s));
+  if (!p_W) return std::nullopt;
+  const Eigen::Vector2f d = p_W->head<2>() - goal_W;
+  const float c = std::cos(heading_rad), sn = std::sin(heading_rad);
+  Eigen::Vector2f offset(c * d.x() + sn * d.y(), -sn * d.x() + c * d.y());
+  float height = p_W->z();  // above the robots' floor, z = 0 (CameraPoseFromState)
+  ArmAim aim;
+  aim.clamped = ArmWorkspaceProblem(m.arm, height, offset);
+  ClampToArmWorkspace(m.arm, &height, &offset);
+  aim.offset_B = ArmOffset(height, offset, r.robot.params().camera_height_m);
+  return aim;
+}
+
+// After a piece driven towards `aim`: the clampings counted, the first of each kind logged.
+void Explorer::CountArmClamps(const RobotRun& r, const ArmAim& aim) {
+  const std::string head = "t=" + Fmt(r.t_s) + " robot " + std::to_string(r.index) + " ";
+  if (!aim.clamped.empty() && result_.camera_position_clamped_workspace++ == 0)
+    result_.plan_log.push_back(
+        head + "camera trajectory position moved into the arm's workspace (" + aim.clamped +
+        "); later ones are counted in camera_position_clamped_workspace");
+  const Eigen::Vector3f left = aim.offset_B - r.robot.state().camera_offset_B;
+  if (!left.isZero(0.f) && result_.camera_position_clamped_speed++ == 0)
+    result_.plan_log.push_back(
+        head + "arm camera held back by the arm's speed (" +
+        Fmt(r.robot.mode_params().arm.speed_mps) + " m/s), " + Fmt(left.norm(), 3) +
+        " m short of the trajectory; later ones are counted in camera_position_clamped_speed");
 }
 
 // One primitive at the view: turn the base, move the arm camera (vp.task), turn the camera
@@ -598,13 +702,18 @@ Status Explorer::Advance(RobotRun& r, double t_end_s) {
       const float max_pitch = r.robot.max_abs_pitch_rad();
       const float speed = r.route_speed_mps.empty() ? r.robot.mode_params().max_speed_mps
                                                     : r.route_speed_mps.front();
+      const double piece_s = double(piece) / std::min(speed, r.robot.mode_params().max_speed_mps);
+      const std::optional<ArmAim> arm = ArmTarget(r, goal, s.heading_rad + dh, r.path_s + piece_s);
       if (Status st = r.robot.DriveAlong(
               goal, speed, s.camera_yaw_rad + WrapAngle(aim.yaw_rad - s.camera_yaw_rad),
-              std::clamp(aim.pitch_rad, -max_pitch, max_pitch));
+              std::clamp(aim.pitch_rad, -max_pitch, max_pitch),
+              arm ? std::optional<Eigen::Vector3f>(arm->offset_B) : std::nullopt);
           !st.ok()) {
         Blocked(r, q, goal, st);
         continue;
       }
+      if (arm) CountArmClamps(r, *arm);
+      r.path_s += piece_s;
       if (piece >= dist) PopWaypoint(r);
       VOXPLAN_RETURN_IF_ERROR(AfterPrimitive(r, c));
       continue;
@@ -849,6 +958,7 @@ void Explorer::CallPlanner(PlanEvent event, int32_t event_robot, const PlannerTa
       if (!rp.camera_trajectory.empty() || replace) {
         r.camera_trajectory = rp.camera_trajectory;
         r.trajectory_t0_s = r.t_s;
+        r.path_s = 0.0;
       }
       if (rp.path_continuous && rp.tasks.empty() && r.queue.empty()) {
         QueuedTask q{tasks.front(), {}};
@@ -914,6 +1024,9 @@ void Explorer::Record(bool with_completeness) {
     if (coverage.ok()) point.coverage = *coverage;
   }
   if (with_completeness && probe_) point.completeness = probe_(*volume_);
+  const double voxel_m3 = std::pow(double(p_.voxel_size_m), 3);
+  point.unobserved_m3 = double(interior_->CountUnobserved(map_)) * voxel_m3;
+  point.mean_uncertainty = MeanSurfaceUncertainty(map_);
   result_.series.push_back(point);
   result_.timings.series_ms += NowMs() - t0;
 }
@@ -922,6 +1035,7 @@ Result<ExploreResult> Explorer::Run(const std::vector<Eigen::Vector2f>& starts) 
   const double run_t0 = NowMs();
   VOXPLAN_RETURN_IF_ERROR(p_.Validate());
   VOXPLAN_RETURN_IF_ERROR(CheckStarts(plan_, starts, p_.robot.radius_m));
+  interior_.emplace(InteriorRegion(plan_, p_));
   Result<std::unique_ptr<MeshRaycaster>> raycaster = MeshRaycaster::Create(world_);
   if (!raycaster.ok()) return raycaster.status();
   raycaster_ = std::move(raycaster).value();

@@ -15,7 +15,8 @@
 // alike. The camera looks along the motion unless the plugin gave a camera trajectory; at the
 // view it turns base and camera to the task's angles, dwells and captures. Base turns, camera
 // joints and driving take their time one after the other. A frame is fused whenever the
-// FusionTrigger fires, and at every view.
+// FusionTrigger fires, and at every view. A continuous path (vp.motion) turns, aims and, on an
+// arm mount, moves the camera to the trajectory's positions while it drives (Robot::DriveAlong).
 // Events: kStart after an initial camera sweep, kInterval every planning interval without a
 // call, kRobotIdle when a robot's queue empties, kTaskFailed. Robot collisions with each other
 // are not simulated (as in Dong 2019).
@@ -185,6 +186,10 @@ struct ExploreResult {
   // Drives the true floor refused (a planner's path or the host's route ran into an obstacle;
   // Xu 2017's blocked paths): each leaves the path, re-routes or fails its task.
   size_t blocked_paths = 0;
+  // Arm camera positions from a camera trajectory along a continuous path, moved into the arm's
+  // workspace, and steps of the camera shortened by the arm's speed (pieces of motion; the first
+  // of each in plan_log).
+  size_t camera_position_clamped_workspace = 0, camera_position_clamped_speed = 0;
   std::vector<RobotTrack> tracks;                    // one per robot: r0, r1, ...
   std::vector<std::vector<ExploreFrame>> frames;     // per robot, every frame it fused
   std::vector<std::vector<PlannerTask>> task_views;  // per robot, views it reached, in order

@@ -64,6 +64,10 @@ json MetricsObject(const ExploreRunParams& params, const ExploreRunReport& repor
 
   json m;
   m["scene"] = params.scene;
+  // Only when the load was asked to move the floor, so other runs keep their bytes: the scene
+  // file's z of the run's floor (a file point is a run point plus this in z; unrounded).
+  if (params.scene_load.detect_floor || params.scene_load.floor_z_m != 0.f)
+    m["scene_floor_z_m"] = double(report.scene_floor_z_m);
   m["planner"] = report.planner_name;
   m["robots"] = params.robots;
   m["seed"] = params.explore.seed;
@@ -126,6 +130,19 @@ json MetricsObject(const ExploreRunParams& params, const ExploreRunReport& repor
   m["camera_ang_accel_radps2"] = RoundTo(camera.mean_abs_angular_accel_radps2, 4);
   m["camera_turning_per_m"] = RoundTo(camera.turning_per_m, 4);
   m["coverage"] = r.series.empty() ? 0.0 : RoundTo(r.series.back().coverage, 4);
+  // The unobserved-volume curve (timeseries.csv): where it starts (after the start sweeps) and
+  // ends, its area as a share of the start held to --max-time, the final surface uncertainty.
+  const auto number = [](double v, int decimals) {
+    return std::isfinite(v) ? json(RoundTo(v, decimals)) : json();
+  };
+  const RunTimePoint none;  // NaN throughout
+  const RunTimePoint& first = r.series.empty() ? none : r.series.front();
+  const RunTimePoint& last = r.series.empty() ? none : r.series.back();
+  m["unobserved_m3_start"] = number(first.unobserved_m3, 3);
+  m["unobserved_m3_final"] = number(last.unobserved_m3, 3);
+  m["unobserved_area_fraction"] =
+      number(UnobservedAreaFraction(r.series, params.explore.max_time_s), 4);
+  m["mean_uncertainty_final"] = number(last.mean_uncertainty, 4);
   m["plan_calls"] = r.plan_calls.size();
   m["plan_ms_median"] = RoundTo(plan_summary.median, 3);  // wall time: varies run to run
   m["plan_ms_p90"] = RoundTo(plan_summary.p90, 3);
@@ -134,6 +151,8 @@ json MetricsObject(const ExploreRunParams& params, const ExploreRunReport& repor
   m["failed_tasks"] = r.failed_tasks;
   m["failed_plan_calls"] = r.failed_plans;
   m["blocked_paths"] = r.blocked_paths;
+  m["camera_position_clamped_workspace"] = r.camera_position_clamped_workspace;
+  m["camera_position_clamped_speed"] = r.camera_position_clamped_speed;
   m["frames_fused"] = r.frames_fused;
   m["objects_detected"] = r.objects_detected;
   m["blocks_dropped_memory"] = r.blocks_dropped;
@@ -216,6 +235,26 @@ Status WriteTimeline(const ExploreResult& r, const std::string& path) {
   }
   if (!any) return Status();  // nothing happened: no picture
   Result<std::string> svg = SvgTimeline(rows, tp);
+  if (!svg.ok()) return svg.status().Naming(path);
+  return WriteFileAtomically(path, *svg);
+}
+
+// unobserved.svg: the unobserved-volume curve over time, from zero to its start.
+Status WriteUnobservedPlot(const ExploreResult& r, const std::string& path) {
+  PlotSeries curve{"unobserved interior", {}, {}};
+  for (const RunTimePoint& p : r.series) {
+    curve.x.push_back(p.t_s);
+    curve.y.push_back(p.unobserved_m3);
+  }
+  if (std::none_of(curve.y.begin(), curve.y.end(), [](double v) { return std::isfinite(v); }))
+    return Status();  // nothing measured: no picture
+  PlotParams pp;
+  pp.title = "Unobserved interior volume (floor to robot height)";
+  pp.x_label = "time (s)";
+  pp.y_label = "unobserved (m³)";
+  pp.y_min = 0.0;
+  pp.y_max = r.series.front().unobserved_m3;  // a flat zero gets the data's range
+  Result<std::string> svg = SvgLinePlot({curve}, pp);
   if (!svg.ok()) return svg.status().Naming(path);
   return WriteFileAtomically(path, *svg);
 }
@@ -325,6 +364,7 @@ Status WriteRunOutputs(const ExploreRunParams& params, const ExploreRunReport& r
   path = InFolder(params.out_dir, "objects.csv");
   if (Status s = WriteLines(ObjectRows(report.objects), path); !s.ok()) return s.Naming(path);
   VOXPLAN_RETURN_IF_ERROR(WriteTimeline(r, InFolder(params.out_dir, "timeline.svg")));
+  VOXPLAN_RETURN_IF_ERROR(WriteUnobservedPlot(r, InFolder(params.out_dir, "unobserved.svg")));
   VOXPLAN_RETURN_IF_ERROR(WriteTopDown(r, InFolder(params.out_dir, "topdown.png")));
   if (!params.explore.keep_planner_drawings) return Status();
   return WriteTopDown(r, InFolder(params.out_dir, "planner.png"), PlannerOverlay(r));
@@ -334,7 +374,7 @@ std::vector<std::string> RunOutputFiles(const std::string& out_dir) {
   std::vector<std::string> paths;
   for (const char* name : {"mesh.ply", "metrics.json", "run_log.csv", "timeseries.csv",
                            "plan_log.txt", "plan_calls.csv", "objects.csv", "robot.json",
-                           "timeline.svg", "topdown.png", "planner.png"})
+                           "timeline.svg", "unobserved.svg", "topdown.png", "planner.png"})
     paths.push_back(InFolder(out_dir, name));
   return paths;
 }

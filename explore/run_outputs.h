@@ -4,8 +4,12 @@
 //   mesh.ply        the final mesh of the fused map
 //   metrics.json    completeness (see completeness_reference), accuracy, distances, balance,
 //                   times, plan calls, termination (with planner_fault: the call a planner
-//                   crashed or hung in); all but plan_ms_* and the fault's times repeat for a seed
-//   timeseries.csv  coverage, completeness (every 30 s, volume estimate), distance vs time
+//                   crashed or hung in); all but plan_ms_* and the fault's times repeat for a seed;
+//                   with a moved floor (--floor-z) scene_floor_z_m, the scene file's z of the
+//                   run's z = 0 (the run's world is the file's moved down by it)
+//   timeseries.csv  coverage, completeness (every 30 s, volume estimate), distance, unobserved
+//                   interior volume and mean surface uncertainty vs time
+//   unobserved.svg  the unobserved interior volume over time
 //   run_log.csv     every robot's poses and status (eval/eval_run.h format)
 //   timeline.svg    per robot: its mode (explorer, reconstructor) or idle over time
 //   topdown.png     the final floor map, each robot's path, start / end marks, reached views

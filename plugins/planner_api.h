@@ -142,7 +142,16 @@ typedef struct vp_path_point {
   float x_m, y_m, theta_rad;
 } vp_path_point;
 
-/* Camera pose along a path (Xu 2017): world position and heading, t_s after the path starts. */
+/* Camera pose along a path (Xu 2017): world position and heading, t_s after the path starts.
+ * The host aims the camera by yaw and pitch. Along a continuous path (vp.motion) on an arm mount
+ * it also moves the camera to `position` (world metres): interpolated in t_s like the angles, at
+ * the path's time for the distance driven (each piece's length at its speed, so by arc length: a
+ * base slowed by turns does not leave the camera ahead), taken in the base frame of the pose
+ * where each piece of motion ends, moved into the arm's workspace and followed at most at the
+ * arm's speed; clampings are counted in metrics.json (camera_position_clamped_workspace,
+ * _speed). A NaN position means none (the arm stays where it is around that sample); on a head,
+ * or along a path that is not continuous, positions are ignored. Other non-finite numbers drop
+ * the trajectory. */
 typedef struct vp_camera_sample {
   float t_s;
   float position[3];

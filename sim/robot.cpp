@@ -2,6 +2,7 @@
 
 #include <Eigen/Geometry>
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <numbers>
 #include <sstream>
@@ -129,9 +130,19 @@ Eigen::Vector3f ArmOffset(float camera_height_m, const Eigen::Vector2f& offset_m
   return {offset_m.x(), offset_m.y(), camera_height_m - head_height_m};
 }
 
+namespace {
+// How far outside the workspace a place still counts as inside: float round trips through the ABI.
+constexpr float kArmSlack_m = 1e-4f, kArmSlack_deg = 1e-2f;
+
+float BearingRad(const Eigen::Vector2f& offset_m) {
+  return offset_m.norm() > 0.f ? std::atan2(offset_m.y(), offset_m.x()) : 0.f;
+}
+float BearingDeg(const Eigen::Vector2f& offset_m) { return BearingRad(offset_m) * 180.f / kPi; }
+}  // namespace
+
 std::string ArmWorkspaceProblem(const ArmParams& arm, float camera_height_m,
                                 const Eigen::Vector2f& offset_m) {
-  constexpr float kSlack = 1e-4f;  // float round trips through the ABI
+  constexpr float kSlack = kArmSlack_m;
   const auto num = [](float v) {
     std::ostringstream s;
     s.precision(3);
@@ -146,12 +157,30 @@ std::string ArmWorkspaceProblem(const ArmParams& arm, float camera_height_m,
   if (reach < arm.reach_min_m - kSlack || reach > arm.reach_max_m + kSlack)
     return "camera reach " + num(reach) + " m outside the arm's [" + num(arm.reach_min_m) + ", " +
            num(arm.reach_max_m) + "] m";
-  const float bearing_deg =
-      reach > 0.f ? std::atan2(offset_m.y(), offset_m.x()) * 180.f / kPi : 0.f;
-  if (std::abs(bearing_deg) > arm.reach_half_angle_deg + 1e-2f)
+  const float bearing_deg = BearingDeg(offset_m);
+  if (std::abs(bearing_deg) > arm.reach_half_angle_deg + kArmSlack_deg)
     return "camera bearing " + num(bearing_deg) + " deg beyond the arm's +-" +
            num(arm.reach_half_angle_deg) + " deg";
   return "";
+}
+
+bool ClampToArmWorkspace(const ArmParams& arm, float* camera_height_m, Eigen::Vector2f* offset_m) {
+  if (!std::isfinite(*camera_height_m) || !offset_m->allFinite()) return false;
+  if (ArmWorkspaceProblem(arm, *camera_height_m, *offset_m).empty()) return false;
+  if (*camera_height_m < arm.height_min_m - kArmSlack_m ||
+      *camera_height_m > arm.height_max_m + kArmSlack_m)
+    *camera_height_m = std::clamp(*camera_height_m, arm.height_min_m, arm.height_max_m);
+  const float reach = offset_m->norm(), bearing_deg = BearingDeg(*offset_m);
+  const bool reach_out =
+      reach < arm.reach_min_m - kArmSlack_m || reach > arm.reach_max_m + kArmSlack_m;
+  const bool bearing_out = std::abs(bearing_deg) > arm.reach_half_angle_deg + kArmSlack_deg;
+  if (reach_out || bearing_out) {  // only then rebuilt, so a height-only clamp keeps the offset
+    const float r = std::clamp(reach, arm.reach_min_m, arm.reach_max_m);
+    const float b =
+        Deg2Rad(std::clamp(bearing_deg, -arm.reach_half_angle_deg, arm.reach_half_angle_deg));
+    *offset_m = r * Eigen::Vector2f(std::cos(b), std::sin(b));
+  }
+  return true;
 }
 
 PinholeCamera CameraWithFov(int width, int height, float horizontal_fov_deg) {
@@ -229,6 +258,39 @@ std::vector<Eigen::Vector2f> FirstContact(const FloorPlan& plan, const Eigen::Ve
       return true;
     });
   return contact;
+}
+
+namespace {
+
+// The arm camera's move between two offsets (RobotState::camera_offset_B) at fraction f:
+// height, reach and bearing each linear, as the arm's joints move. The workspace is a box in
+// those, so the move stays inside it when both ends are; a straight line would cut through the
+// reach's inner limit, and a camera projected back onto it there would never get past.
+Eigen::Vector3f ArmPathPoint(const Eigen::Vector3f& from, const Eigen::Vector3f& to, float f) {
+  const float r = from.head<2>().norm() + f * (to.head<2>().norm() - from.head<2>().norm());
+  const float b0 = BearingRad(from.head<2>()), b1 = BearingRad(to.head<2>());
+  const float b = b0 + f * (b1 - b0);
+  return {r * std::cos(b), r * std::sin(b), from.z() + f * (to.z() - from.z())};
+}
+
+}  // namespace
+
+Eigen::Vector3f ArmStep(const Eigen::Vector3f& from, const Eigen::Vector3f& to, float max_m) {
+  // The path's length from its chords; a step ends where that length reaches max_m.
+  constexpr int kChords = 16;
+  std::array<float, kChords + 1> along{};
+  Eigen::Vector3f last = from;
+  for (int k = 1; k <= kChords; ++k) {
+    const Eigen::Vector3f p = ArmPathPoint(from, to, float(k) / kChords);
+    along[size_t(k)] = along[size_t(k - 1)] + (p - last).norm();
+    last = p;
+  }
+  if (along.back() <= max_m) return to;
+  int k = 1;
+  while (along[size_t(k)] < max_m) ++k;
+  const float chord = along[size_t(k)] - along[size_t(k - 1)];
+  const float within = chord > 0.f ? (max_m - along[size_t(k - 1)]) / chord : 0.f;
+  return ArmPathPoint(from, to, (float(k - 1) + within) / kChords);
 }
 
 Result<Robot> Robot::Create(const RobotParams& params, FloorPlan plan, const RobotState& start,
@@ -309,11 +371,22 @@ Status Robot::DriveTo(const Eigen::Vector2f& goal_W) {
 }
 
 Status Robot::DriveAlong(const Eigen::Vector2f& goal_W, float speed_mps, float camera_yaw_rad,
-                         float camera_pitch_rad) {
+                         float camera_pitch_rad,
+                         const std::optional<Eigen::Vector3f>& arm_offset_B) {
   if (!goal_W.allFinite() || !(speed_mps > 0.f) || !std::isfinite(camera_yaw_rad))
     return InvalidArgument("Robot::DriveAlong: goal, speed or camera yaw is not valid");
   if (!(std::abs(camera_pitch_rad) <= max_abs_pitch_rad()))
     return InvalidArgument("Robot::DriveAlong: pitch beyond the limit");
+  const float head_h = params_.camera_height_m;
+  if (arm_offset_B) {
+    if (mode_params().mount != MountKind::kArm)
+      return InvalidArgument("Robot::DriveAlong: the " + std::string(RobotModeName(mode_)) +
+                             " camera is on a head");
+    const Eigen::Vector3f& o = *arm_offset_B;
+    if (const std::string why = ArmWorkspaceProblem(mode_params().arm, o.z() + head_h, o.head<2>());
+        !why.empty())
+      return InvalidArgument("Robot::DriveAlong: " + why);
+  }
   const Eigen::Vector2f delta = goal_W - state_.position_W;
   const float length = delta.norm();
   if (length > 0.f && !SegmentFree(plan_, state_.position_W, goal_W, params_.radius_m))
@@ -334,6 +407,9 @@ Status Robot::DriveAlong(const Eigen::Vector2f& goal_W, float speed_mps, float c
   state_.heading_rad += turn;
   state_.camera_yaw_rad = camera_yaw_rad;
   state_.camera_pitch_rad = camera_pitch_rad;
+  if (arm_offset_B)
+    state_.camera_offset_B =
+        ArmStep(state_.camera_offset_B, *arm_offset_B, float(duration) * m.arm.speed_mps);
   return Status::Ok();
 }
 

@@ -7,6 +7,7 @@
 #include <Eigen/Core>
 #include <cstdint>
 #include <numbers>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -95,6 +96,16 @@ Eigen::Vector3f ArmOffset(float camera_height_m, const Eigen::Vector2f& offset_m
                           float head_height_m);
 std::string ArmWorkspaceProblem(const ArmParams& arm, float camera_height_m,
                                 const Eigen::Vector2f& offset_m);
+// Moves a finite camera height and offset into the workspace, one coordinate at a time (it is a
+// box in height, reach and bearing): the height into its range, the bearing within its half
+// angle, the reach into its range (straight ahead from zero reach). Returns whether it moved
+// them, i.e. whether ArmWorkspaceProblem had one; a place inside is left as it is.
+bool ClampToArmWorkspace(const ArmParams& arm, float* camera_height_m, Eigen::Vector2f* offset_m);
+// Where the arm camera gets from offset `from` towards `to` (RobotState::camera_offset_B) moving
+// at most max_m along its path: height, reach and bearing each change linearly, as the joints
+// move, so the path stays in the workspace when both ends are (a straight line could pass
+// through the reach's inner limit). `to` itself when the path is no longer than max_m.
+Eigen::Vector3f ArmStep(const Eigen::Vector3f& from, const Eigen::Vector3f& to, float max_m);
 // Square-pixel camera with the given horizontal field of view, principal point at the centre.
 PinholeCamera CameraWithFov(int width, int height, float horizontal_fov_deg);
 
@@ -146,8 +157,14 @@ class Robot {
   // once, so the piece takes the longest of length / speed (clamped to the mode's), the base's
   // turn at its rate and each joint's move at its rate. Refuses (state and clock unchanged) what
   // DriveTo refuses and a pitch beyond the limit.
+  // With `arm_offset_B` (RobotState::camera_offset_B; an arm mount, inside its workspace, else
+  // refused) the arm camera moves towards it during the piece too (ArmStep), by at most the arm's
+  // speed times the piece's time: the piece takes no longer for it, so the base keeps its speed
+  // profile and a camera trajectory timed along it its timing; a farther target is reached by
+  // later pieces. The caller sees a step cut short as camera_offset_B differing from the target.
   Status DriveAlong(const Eigen::Vector2f& goal_W, float speed_mps, float camera_yaw_rad,
-                    float camera_pitch_rad);
+                    float camera_pitch_rad,
+                    const std::optional<Eigen::Vector3f>& arm_offset_B = std::nullopt);
   // Camera joints; each costs |Δangle| / joint rate. Pitch beyond the limit is refused.
   void SetCameraYaw(float yaw_rad);
   Status SetCameraPitch(float pitch_rad);

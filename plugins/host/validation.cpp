@@ -184,7 +184,9 @@ void Validate(const PlannerWorld& world, const std::vector<PlannerRobot>& robots
     }
     for (size_t i = 0; i < plan.camera_trajectory.size(); ++i) {
       const CameraSample& s = plan.camera_trajectory[i];
-      const bool finite = s.position_m.allFinite() && AllFinite({s.t_s, s.yaw_rad, s.pitch_rad});
+      // A NaN position is "none" (vp_camera_sample): only infinities are refused there.
+      const bool finite =
+          !s.position_m.array().isInf().any() && AllFinite({s.t_s, s.yaw_rad, s.pitch_rad});
       if (!finite || (i > 0 && s.t_s < plan.camera_trajectory[i - 1].t_s)) {
         Reject(result, planner, int32_t(r), -1,
                "camera trajectory dropped: sample " + std::to_string(i) +

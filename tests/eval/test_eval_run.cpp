@@ -137,9 +137,30 @@ TEST(RunTimeSeries, DistanceAndBusyRobotsOverTime) {
   auto text = ReadFileToString(path);
   ASSERT_TRUE(text.ok());
   EXPECT_EQ(*text,
-            "t,distance_total_m,busy_robots,coverage,completeness\n"
-            "0,0,2,,\n"
-            "1,2,2,0.25,\n");
+            "t,distance_total_m,busy_robots,coverage,completeness,unobserved_m3,mean_uncertainty\n"
+            "0,0,2,,,,\n"
+            "1,2,2,0.25,,,\n");
+}
+
+TEST(RunTimeSeries, UnobservedAreaFractionHoldsTheLastValueToTheHorizon) {
+  std::vector<RunTimePoint> series(4);
+  const double t[] = {0.0, 10.0, 20.0, 30.0}, u[] = {std::nan(""), 100.0, 50.0, 50.0};
+  for (size_t i = 0; i < series.size(); ++i) {
+    series[i].t_s = t[i];
+    series[i].unobserved_m3 = u[i];
+  }
+  // From t = 10 (the first value) to 30: 750 + 500 over 100 x 20.
+  EXPECT_DOUBLE_EQ(UnobservedAreaFraction(series, 0.0), 1250.0 / 2000.0);
+  // To a horizon of 50: the last 50 m3 held for 20 s more.
+  EXPECT_DOUBLE_EQ(UnobservedAreaFraction(series, 50.0), 2250.0 / 4000.0);
+  // Nothing observed after the start: 1.
+  for (RunTimePoint& p : series)
+    p.unobserved_m3 = std::isnan(p.unobserved_m3) ? p.unobserved_m3 : 8.0;
+  EXPECT_DOUBLE_EQ(UnobservedAreaFraction(series, 40.0), 1.0);
+  EXPECT_TRUE(std::isnan(UnobservedAreaFraction({}, 10.0)));
+  EXPECT_TRUE(std::isnan(UnobservedAreaFraction({series[1]}, 0.0)));  // no span
+  series[1].unobserved_m3 = 0.0;
+  EXPECT_TRUE(std::isnan(UnobservedAreaFraction(series, 40.0)));  // nothing to observe
 }
 
 TEST(RunLog, RoundTripKeepsEveryValue) {

@@ -403,6 +403,121 @@ TEST(Explore, ContinuousPathTurnsWhileDrivingAtItsSpeedAndEndsWithoutAStop) {
   EXPECT_GE(pieces, 4);
 }
 
+// A 2 m leg along +x (the robot starts heading that way) with room on both sides.
+bool StraightLeg(const FloorPlan& plan, float clearance_m, Eigen::Vector2f* start,
+                 Eigen::Vector2f* goal) {
+  for (int i = 0; i < plan.width * plan.height; ++i) {
+    const Eigen::Vector2f c = plan.CellCenter(i % plan.width, i / plan.width);
+    if (SegmentFree(plan, c, c + Eigen::Vector2f(2.f, 0.f), clearance_m)) {
+      *start = c;
+      *goal = c + Eigen::Vector2f(2.f, 0.f);
+      return true;
+    }
+  }
+  return false;
+}
+
+// The camera's offset from the base (forward, left, height) at the robot's last frame.
+Eigen::Vector3f LastFrameOffset(const ExploreResult& run) {
+  const ExploreFrame& f = run.frames[0].back();
+  const std::vector<RobotSample>& samples = run.tracks[0].samples;
+  // Each frame is taken right after the sample of its time.
+  const auto at = std::find_if(samples.rbegin(), samples.rend(),
+                               [&](const RobotSample& s) { return s.t_s == f.t_s; });
+  EXPECT_NE(at, samples.rend());
+  if (at == samples.rend()) return Eigen::Vector3f::Constant(NAN);
+  const Eigen::Vector3f p = f.T_W_C.translation();
+  const float dx = p.x() - float(at->x_m), dy = p.y() - float(at->y_m);
+  const float c = std::cos(float(at->yaw_rad)), sn = std::sin(float(at->yaw_rad));
+  return {c * dx + sn * dy, -sn * dx + c * dy, p.z()};
+}
+
+TEST(Explore, AnArmCameraFollowsTheTrajectorysPositionsAlongAContinuousPath) {
+  // goto's continuous path with a camera trajectory that holds the camera 0.8 m up at (0.5, 0.2)
+  // from the base. On an arm the camera gets there from its rest (0.3 m ahead at head height,
+  // 0.49 m away) at the arm's 0.25 m/s: held back by its speed for the first pieces (the first,
+  // 1 s long while the camera turns round from the start sweep, then 0.1 m per 0.4 s piece),
+  // then on the offset to the end, the delay not putting it ahead (positions keyed by the
+  // distance driven). Outside the workspace (2 m up) it is clamped to the arm's 1.5 m. Without
+  // positions (NaN) and on a head the positions are ignored.
+  const Scene& s = SmallApartment();
+  ExploreParams params = FastParams();
+  params.max_time_s = 120.0;
+  params.robot.explorer.mount = MountKind::kArm;  // a path without tasks drives as the explorer
+  params.robot.explorer.capture_hz = 10.f;        // a frame after every piece
+  Eigen::Vector2f start, goal;
+  ASSERT_TRUE(StraightLeg(s.plan, params.robot.radius_m + 0.3f, &start, &goal));
+  auto drive = [&](const ExploreParams& p, const std::string& camera) {
+    std::unique_ptr<LoadedPlanner> planner =
+        Goto(goal, "\"continuous\": 1, \"camera_position\": 1" + camera);
+    EXPECT_TRUE(planner);
+    Result<ExploreResult> run = RunExplore(s.world, s.plan, {start}, *planner, p, {});
+    EXPECT_TRUE(run.ok()) << run.status().message();
+    EXPECT_EQ(run->terminated, "done");
+    EXPECT_EQ(run->rejected_tasks, 0u);
+    return std::move(run).value();
+  };
+  auto logged = [](const ExploreResult& run, const std::string& what) {
+    int n = 0;
+    for (const std::string& line : run.plan_log) n += line.find(what) != std::string::npos;
+    return n;
+  };
+  constexpr float kAt_m = 1e-3f;
+  const std::string offset = ", \"offset_x\": 0.5, \"offset_y\": 0.2";
+  const ExploreResult held = drive(params, ", \"height\": 0.8" + offset);
+  EXPECT_TRUE(LastFrameOffset(held).isApprox(Eigen::Vector3f(0.5f, 0.2f, 0.8f), kAt_m))
+      << LastFrameOffset(held).transpose();
+  EXPECT_EQ(held.camera_position_clamped_workspace, 0u);
+  EXPECT_GE(held.camera_position_clamped_speed, 3u);  // 0.26 m, then 0.1 m a piece, of 0.49
+  EXPECT_LE(held.camera_position_clamped_speed, 5u);
+  EXPECT_EQ(logged(held, "held back by the arm's speed"), 1);  // the first only
+
+  const ExploreResult high = drive(params, ", \"height\": 2.0" + offset);
+  EXPECT_TRUE(LastFrameOffset(high).isApprox(Eigen::Vector3f(0.5f, 0.2f, 1.5f), kAt_m))
+      << LastFrameOffset(high).transpose();
+  EXPECT_GE(high.camera_position_clamped_workspace, 9u);  // every piece: 2 m in 0.2 m pieces
+  EXPECT_EQ(logged(high, "moved into the arm's workspace (camera height 2 m"), 1);
+
+  const ExploreResult none = drive(params, offset);  // no height: NaN positions
+  EXPECT_TRUE(LastFrameOffset(none).isApprox(
+      Eigen::Vector3f(params.robot.explorer.arm.reach_min_m, 0.f, params.robot.camera_height_m),
+      kAt_m))
+      << LastFrameOffset(none).transpose();
+  EXPECT_EQ(none.camera_position_clamped_workspace + none.camera_position_clamped_speed, 0u);
+
+  ExploreParams head = params;
+  head.robot.explorer.mount = MountKind::kHead;
+  const ExploreResult on_head = drive(head, ", \"height\": 0.8" + offset);
+  EXPECT_TRUE(LastFrameOffset(on_head).isApprox(
+      Eigen::Vector3f(0.f, 0.f, params.robot.camera_height_m), kAt_m))
+      << LastFrameOffset(on_head).transpose();
+  EXPECT_EQ(on_head.camera_position_clamped_workspace + on_head.camera_position_clamped_speed, 0u);
+}
+
+TEST(Explore, TheUnobservedVolumeOnlyFallsAndTheSurfaceUncertaintyIsMeasured) {
+  // Every series row measures the scene's interior (floor to the floor map's band top, over the
+  // true plan's floor) the planning map has not observed: positive after the start sweep, below
+  // the interior's volume, never rising (fused weights never fall), lower at the end.
+  ExploreParams params = FastParams();
+  params.max_time_s = 60.0;
+  Result<ExploreResult> run = RunGreedy(params, 1);
+  ASSERT_TRUE(run.ok()) << run.status().message();
+  const std::vector<RunTimePoint>& series = run->series;
+  ASSERT_GE(series.size(), 5u);
+  const double interior_m3 = FloorArea(SmallApartment().plan) * params.floor.band_max_m;
+  EXPECT_GT(series.front().unobserved_m3, 0.0);
+  EXPECT_LT(series.front().unobserved_m3, interior_m3);
+  for (size_t i = 1; i < series.size(); ++i) {
+    EXPECT_LE(series[i].unobserved_m3, series[i - 1].unobserved_m3) << "row " << i;
+    EXPECT_GT(series[i].mean_uncertainty, 0.0);
+    EXPECT_LE(series[i].mean_uncertainty, 1.0);
+  }
+  EXPECT_LT(series.back().unobserved_m3, 0.8 * series.front().unobserved_m3);
+  const double area = UnobservedAreaFraction(series, params.max_time_s);
+  EXPECT_GT(area, series.back().unobserved_m3 / series.front().unobserved_m3);
+  EXPECT_LT(area, 1.0);
+}
+
 TEST(Explore, RequestedCallsComeAtTheFirstStepAfterTheirTime) {
   // vp.schedule: goto asks to be called 1.3 s after each call; the loop steps by step_s, so each
   // wakeup comes in [1.3, 1.3 + step_s) after the call before it. A request past 600 s ahead is

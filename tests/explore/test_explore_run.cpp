@@ -93,7 +93,7 @@ TEST(ExploreRun, ShortRunWritesEveryArtefactAndItsMetricsAgree) {
   EXPECT_GE(progress_calls, 1u);
 
   for (const char* f : {"mesh.ply", "metrics.json", "timeseries.csv", "run_log.csv", "topdown.png",
-                        "plan_log.txt", "plan_calls.csv"})
+                        "plan_log.txt", "plan_calls.csv", "unobserved.svg"})
     EXPECT_TRUE(fs::is_regular_file(dir / "out" / f)) << f;
   EXPECT_GT(fs::file_size(dir / "out" / "mesh.ply"), 1000u);
   EXPECT_GT(fs::file_size(dir / "out" / "topdown.png"), 1000u);

@@ -1,12 +1,17 @@
 // Planning maps on a box room seen from its centre: states, frontier and surface voxels against
-// brute force, uncertainty, normals, ray casts, label fusion and incremental vs rebuilt maps.
+// brute force, uncertainty, normals, ray casts, label fusion and incremental vs rebuilt maps; the
+// map summaries of a run's time series (map_summary.h) against brute force.
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <cmath>
 #include <optional>
 #include <random>
 #include <set>
+#include <utility>
 
 #include "planning/integrate_planning.h"
+#include "planning/map_summary.h"
 #include "planning/planning_map.h"
 #include "tests/fusion/box_room.h"
 
@@ -365,6 +370,54 @@ TEST(PlanningMap, RefusesMismatchedInputs) {
   EXPECT_FALSE(
       IntegratePlanningFrame(depth, {}, &small, fx.cam, pose, fx.params, fx.volume, fx.map).ok());
   EXPECT_THROW(PlanningMap(fx.volume, PlanningMapParams{{0.f, 0.5f}, 0.5f}), std::invalid_argument);
+}
+
+TEST(MapSummary, UnobservedVoxelsOfARegionAndMeanUncertaintyMatchBruteForce) {
+  // A region across block faces on every axis, negative coordinates included, reaching past the
+  // room into blocks never allocated; a hole and duplicate columns.
+  std::vector<Eigen::Vector2i> columns;
+  for (int y = -37; y <= 21; ++y)
+    for (int x = -45; x <= 33; ++x)
+      if (!(x > -5 && x < 4 && y > -3 && y < 6)) columns.emplace_back(x, y);
+  columns.emplace_back(0, -37);
+  columns.emplace_back(-45, 21);
+  const int z0 = -13, z1 = 11;
+  const ColumnRegion region(columns, z0, z1);
+  std::set<std::pair<int, int>> distinct;
+  for (const Eigen::Vector2i& c : columns) distinct.insert({c.x(), c.y()});
+  ASSERT_EQ(region.voxels(), distinct.size() * size_t(z1 - z0));
+  auto brute = [&](const PlanningMap& map) {
+    size_t n = 0;
+    for (const auto& [x, y] : distinct)
+      for (int z = z0; z < z1; ++z)
+        n += map.StateAt(GlobalVoxelIndex{x, y, z}) == VoxelState::kUnobserved;
+    return n;
+  };
+  auto mean_uncertainty = [](const PlanningMap& map) {
+    double sum = 0.0;
+    const std::vector<MapSurfaceVoxel> surface = map.SurfaceVoxels();
+    for (const MapSurfaceVoxel& v : surface) sum += std::clamp(v.uncertainty, 0.f, 1.f);
+    return surface.empty() ? std::nan("") : sum / double(surface.size());
+  };
+
+  Fixture fx;
+  EXPECT_EQ(region.CountUnobserved(fx.map), region.voxels());  // an empty map
+  EXPECT_TRUE(std::isnan(MeanSurfaceUncertainty(fx.map)));
+  size_t last = region.voxels();
+  const std::vector<Pose3f> views = test::AxisViews(kEye);
+  for (size_t k = 0; k < views.size(); ++k) {
+    fx.Fuse(views[k]);
+    if (k == 2) fx.Fuse(views[k]);  // some walls seen twice: weights above 1
+    const size_t unobserved = region.CountUnobserved(fx.map);
+    EXPECT_EQ(unobserved, brute(fx.map)) << "after view " << k;
+    EXPECT_LE(unobserved, last) << "observed voxels stay observed";
+    EXPECT_LT(unobserved, region.voxels());
+    last = unobserved;
+    EXPECT_NEAR(MeanSurfaceUncertainty(fx.map), mean_uncertainty(fx.map), 1e-9) << k;
+  }
+  EXPECT_GT(last, 0u);  // beyond the walls
+  EXPECT_EQ(ColumnRegion(columns, 4, 4).voxels(), 0u);
+  EXPECT_EQ(ColumnRegion(columns, 4, 4).CountUnobserved(fx.map), 0u);
 }
 
 }  // namespace

@@ -118,6 +118,88 @@ TEST(Robot, RefusesBlockedMovesAndKeepsState) {
   EXPECT_EQ(robot->state().heading_rad, 0.f);
 }
 
+TEST(Robot, TheArmCameraMovesWithAContinuousPieceAtItsSpeedInsideItsWorkspace) {
+  RobotParams params;
+  params.explorer.mount = MountKind::kArm;  // Fetch-sized defaults, 0.25 m/s
+  const ArmParams& arm = params.explorer.arm;
+  auto robot = Robot::Create(params, SquareWithPillar(), At(0.6f, 0.6f));
+  ASSERT_TRUE(robot.ok());
+  const Eigen::Vector3f rest = robot->state().camera_offset_B;  // 0.3 m ahead, head height
+  const Eigen::Vector3f target = ArmOffset(0.8f, {0.5f, 0.2f}, params.camera_height_m);
+  // 0.4 m at 0.5 m/s: the piece's 0.8 s, the arm's speed moves the camera 0.2 m of its 0.49.
+  const float step_m = 0.8f * arm.speed_mps;
+  ASSERT_TRUE(robot->DriveAlong({1.0f, 0.6f}, 0.5f, 0.f, 0.f, target).ok());
+  EXPECT_NEAR(robot->clock_s(), 0.8, kClockTolerance_s);  // the arm does not slow the base
+  Eigen::Vector3f o = robot->state().camera_offset_B;
+  EXPECT_NEAR((o - rest).norm(), step_m, 2e-3f);  // along its path, a little off the chord
+  EXPECT_LE((o - rest).norm(), step_m + 1e-5f);
+  EXPECT_LT((target - o).norm(), (target - rest).norm() - 0.9f * step_m);
+  ASSERT_TRUE(robot->DriveAlong({1.4f, 0.6f}, 0.5f, 0.f, 0.f, target).ok());
+  EXPECT_NE(robot->state().camera_offset_B, target);
+  ASSERT_TRUE(robot->DriveAlong({1.8f, 0.6f}, 0.5f, 0.f, 0.f, target).ok());
+  EXPECT_EQ(robot->state().camera_offset_B, target);
+  EXPECT_NEAR(robot->clock_s(), 2.4, kClockTolerance_s);
+  EXPECT_TRUE(robot->T_W_C().translation().isApprox(Eigen::Vector3f(2.3f, 0.8f, 0.8f), 1e-5f));
+
+  // From one side of the base to the other: around the front, inside the workspace at every
+  // step (a straight line would pass through the base, within the reach's inner limit).
+  const Eigen::Vector3f right = ArmOffset(1.0f, {0.f, -0.5f}, params.camera_height_m);
+  ASSERT_TRUE(robot->SetArmCamera(1.0f, {0.f, 0.5f}).ok());
+  Eigen::Vector2f goal = robot->state().position_W;
+  int pieces = 0;
+  for (; pieces < 60 && robot->state().camera_offset_B != right; ++pieces) {
+    goal.x() += 0.02f;  // 0.2 s at 0.1 m/s: 0.05 m of the arm's path
+    ASSERT_TRUE(robot->DriveAlong(goal, 0.1f, 0.f, 0.f, right).ok());
+    const Eigen::Vector3f& at = robot->state().camera_offset_B;
+    EXPECT_EQ(ArmWorkspaceProblem(arm, at.z() + params.camera_height_m, at.head<2>()), "");
+    EXPECT_NEAR(at.head<2>().norm(), 0.5f, 1e-5f);
+  }
+  EXPECT_EQ(robot->state().camera_offset_B, right);
+  EXPECT_GE(pieces, 31);  // half a turn at 0.5 m: 1.57 m
+  EXPECT_LE(pieces, 32);
+
+  // Refused, state and clock unchanged: a target outside the workspace; an arm target on a head.
+  const double t = robot->clock_s();
+  const Status outside =
+      robot->DriveAlong(robot->state().position_W + Eigen::Vector2f(0.1f, 0.f), 0.5f, 0.f, 0.f,
+                        ArmOffset(2.0f, {0.5f, 0.f}, params.camera_height_m));
+  EXPECT_FALSE(outside.ok());
+  EXPECT_NE(outside.message().find("camera height"), std::string::npos) << outside.message();
+  EXPECT_EQ(robot->clock_s(), t);
+  EXPECT_EQ(robot->state().camera_offset_B, right);
+  robot->SetMode(RobotMode::kReconstructor);  // on a head
+  EXPECT_FALSE(robot
+                   ->DriveAlong(robot->state().position_W + Eigen::Vector2f(0.1f, 0.f), 0.5f, 0.f,
+                                0.f, target)
+                   .ok());
+}
+
+TEST(Robot, ClampToArmWorkspaceMovesEachCoordinateIntoItsRange) {
+  const ArmParams arm;  // 0.4-1.5 m high, 0.3-0.8 m reach, +-90 deg
+  float h = 1.0f;
+  Eigen::Vector2f o(0.5f, 0.1f);
+  EXPECT_FALSE(ClampToArmWorkspace(arm, &h, &o));  // inside: unchanged
+  EXPECT_EQ(h, 1.0f);
+  EXPECT_EQ(o, Eigen::Vector2f(0.5f, 0.1f));
+  h = 2.0f;
+  EXPECT_TRUE(ClampToArmWorkspace(arm, &h, &o));  // only the height was out
+  EXPECT_EQ(h, 1.5f);
+  EXPECT_EQ(o, Eigen::Vector2f(0.5f, 0.1f));
+  o = {2.0f, 0.f};
+  EXPECT_TRUE(ClampToArmWorkspace(arm, &h, &o));  // too far: the reach's limit, same bearing
+  EXPECT_NEAR(o.x(), 0.8f, 1e-6f);
+  EXPECT_NEAR(o.y(), 0.f, 1e-6f);
+  o = {-0.5f, 0.1f};  // behind the base: to the bearing limit on its side, reach kept
+  EXPECT_TRUE(ClampToArmWorkspace(arm, &h, &o));
+  EXPECT_NEAR(o.x(), 0.f, 1e-6f);
+  EXPECT_NEAR(o.y(), std::hypot(0.5f, 0.1f), 1e-6f);
+  o = {0.f, 0.f};  // at the base: straight ahead at the nearest reach
+  EXPECT_TRUE(ClampToArmWorkspace(arm, &h, &o));
+  EXPECT_NEAR(o.x(), 0.3f, 1e-6f);
+  EXPECT_NEAR(o.y(), 0.f, 1e-6f);
+  EXPECT_EQ(ArmWorkspaceProblem(arm, h, o), "");
+}
+
 TEST(Robot, CameraPoseFromState) {
   RobotState s = At(1.f, 2.f, kPi / 2);  // base facing +y
   const Pose3f a = CameraPoseFromState(s, 1.2f);

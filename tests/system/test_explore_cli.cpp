@@ -62,9 +62,12 @@ TEST(ExploreCli, ShortRunWritesEveryOutputAndRepeatsItself) {
     metrics.push_back(nlohmann::json::parse(ReadAll(dir / sub / "metrics.json")));
   }
   nlohmann::json& m = metrics[0];
-  for (const char* key : {"completeness", "accuracy_rms_m", "distance_per_robot_m",
-                          "distance_total_m", "distance_per_area", "load_balance_cov", "time_s",
-                          "idle_time_s", "plan_ms_median", "plan_calls", "terminated"})
+  for (const char* key :
+       {"completeness", "accuracy_rms_m", "distance_per_robot_m", "distance_total_m",
+        "distance_per_area", "load_balance_cov", "time_s", "idle_time_s", "plan_ms_median",
+        "plan_calls", "terminated", "camera_position_clamped_workspace",
+        "camera_position_clamped_speed", "unobserved_m3_start", "unobserved_m3_final",
+        "unobserved_area_fraction", "mean_uncertainty_final"})
     EXPECT_TRUE(m.contains(key)) << key;
   const std::string terminated = m["terminated"].get<std::string>();
   EXPECT_TRUE(terminated == "done" || terminated == "time_limit") << terminated;

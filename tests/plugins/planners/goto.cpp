@@ -5,7 +5,10 @@
 // "height", "offset_x"/"offset_y" (arm), "look_x"/"look_y"/"look_z", "sweep_min"/"sweep_max"/
 // "sweep_step" (radians). vp.motion and vp.schedule: "continuous": 1 sends a straight path to the
 // goal (points every 0.2 m, no tasks) to be driven without stopping, at "speed" (m/s) when given;
-// "wakeup": dt asks to be called dt seconds after every call.
+// "wakeup": dt asks to be called dt seconds after every call. "camera_position": 1 with
+// "continuous" adds a camera trajectory that looks along the path and holds the camera at
+// "height" and "offset_x"/"offset_y" from the base at each path point (NaN positions without a
+// "height"), timed at the path's speed.
 #include <algorithm>
 #include <cmath>
 #include <cstdlib>
@@ -58,6 +61,7 @@ class Goto : public vp::Planner {
     continuous_ = OptionalNumber(j, "continuous") == 1.f;
     speed_mps_ = OptionalNumber(j, "speed");
     wakeup_s_ = OptionalNumber(j, "wakeup");
+    camera_position_ = OptionalNumber(j, "camera_position") == 1.f;
   }
 
   void Plan(const vp::WorldView& world, vp::PlanOutput& out) override {
@@ -83,6 +87,28 @@ class Goto : public vp::Planner {
                           robot.y_m + dy * float(k) / float(n), task.theta_rad});
       const std::vector<float> speeds(std::isnan(speed_mps_) ? 0 : points.size(), speed_mps_);
       out.SetContinuousPath(0, points, speeds);
+      if (camera_position_) {
+        const float speed =
+            std::isnan(speed_mps_)
+                ? world.Mode(0, VP_MODE_EXPLORER).max_speed_mps
+                : std::min(speed_mps_, world.Mode(0, VP_MODE_EXPLORER).max_speed_mps);
+        const float c = std::cos(task.theta_rad), sn = std::sin(task.theta_rad);
+        const float ox = ext_.camera_offset_m[0], oy = ext_.camera_offset_m[1];
+        std::vector<vp_camera_sample> samples;
+        float t_s = 0.f, x = robot.x_m, y = robot.y_m;
+        for (size_t k = 0; k <= points.size(); ++k) {
+          if (k > 0) {
+            t_s += std::hypot(points[k - 1].x_m - x, points[k - 1].y_m - y) / speed;
+            x = points[k - 1].x_m;
+            y = points[k - 1].y_m;
+          }
+          samples.push_back({t_s,
+                             {x + c * ox - sn * oy, y + sn * ox + c * oy, ext_.camera_height_m},
+                             task.theta_rad,
+                             0.f});
+        }
+        out.SetCameraTrajectory(0, samples);
+      }
       return;
     }
     if (with_ext_) {
@@ -98,7 +124,7 @@ class Goto : public vp::Planner {
   float dwell_s_ = 0.f;
   vp_task_ext ext_{};
   bool with_ext_ = false;
-  bool continuous_ = false;
+  bool continuous_ = false, camera_position_ = false;
   float speed_mps_ = 0.f, wakeup_s_ = 0.f;  // NaN: not asked for
 };
 
