@@ -80,6 +80,14 @@ bool RobotPlanner::Stuck() const {
   return (history_.back() - history_[history_.size() - 1 - n]).norm() < options_.stuck_m;
 }
 
+SkeletonParams RobotPlanner::SkeletonFor(const RobotInput& robot) const {
+  SkeletonParams sp;
+  sp.min_relative_magnitude = 1e-5;
+  sp.block_clearance_m = robot.radius_m;
+  sp.max_length_m = 2.0 * options_.window_m;
+  return sp;
+}
+
 void RobotPlanner::BuildKeyFrame(const FloorInput& floor, const RobotInput& robot, double t_s,
                                  StepOutput* out) {
   const double t0 = NowMs();
@@ -104,6 +112,16 @@ void RobotPlanner::BuildKeyFrame(const FloorInput& floor, const RobotInput& robo
         static_cast<int>(FindVectorSingularities(BlendVectorField(window_.geometry, samples, domain,
                                                                   VectorConstraint::kTangent, kp))
                              .size());
+  }
+  if (options_.topology_control && options_.field == FieldKind::kTensor) {
+    // X8 (d) on the key frame, before the frames between key frames are interpolated from it.
+    TopologyParams tp;
+    tp.min_relative_magnitude = 1e-5;
+    const std::vector<DegeneratePoint> points = FindDegeneratePoints(next, tp);
+    AdvectionObstacles obstacles;
+    obstacles.clearance = &window_.clearance;
+    const Skeleton skeleton = ExtractSkeleton(next, points, SkeletonFor(robot), obstacles);
+    cancelled_pairs_ += CancelDegeneratePairs(&next, points, skeleton, window_.clearance).cancelled;
   }
   const double t_census = NowMs();
   frames_.clear();
@@ -140,13 +158,9 @@ void RobotPlanner::BuildTopology(const RobotInput& robot, const ViewGain& gain, 
   TopologyParams tp;
   tp.min_relative_magnitude = 1e-5;
   key_points_ = FindDegeneratePoints(frame, tp);
-  SkeletonParams sp;
-  sp.min_relative_magnitude = 1e-5;
-  sp.block_clearance_m = robot.radius_m;
-  sp.max_length_m = 2.0 * options_.window_m;
   AdvectionObstacles obstacles;
   obstacles.clearance = &window_.clearance;
-  skeleton_ = ExtractSkeleton(frame, key_points_, sp, obstacles);
+  skeleton_ = ExtractSkeleton(frame, key_points_, SkeletonFor(robot), obstacles);
   edge_gain_ = EdgeGains(skeleton_, [&](const SkeletonEdge& e) {
     return MeanAlongPolyline(
         e.polyline, [&](const Eigen::Vector2d& p) { return gain.PointGain(p); }, 0.3);
@@ -457,6 +471,7 @@ StepOutput RobotPlanner::Step(const FloorInput& floor, const RobotInput& robot, 
     out.diag.pathlines = blocked_.pathlines;
     out.diag.branch_choices = branch_choices_;
     out.diag.skeleton_routes = skeleton_routes_;
+    out.diag.cancelled_pairs = cancelled_pairs_;
     out.diag.settled_goals = static_cast<int>(visited_goals_.size());
     return std::move(out);
   };

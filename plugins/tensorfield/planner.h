@@ -21,6 +21,7 @@
 #include "plugins/tensorfield/algorithms/camera_path.h"
 #include "plugins/tensorfield/algorithms/skeleton.h"
 #include "plugins/tensorfield/algorithms/tensor_field.h"
+#include "plugins/tensorfield/algorithms/topology_control.h"
 #include "plugins/tensorfield/frames.h"
 
 namespace voxplan::tensorfield {
@@ -46,6 +47,8 @@ struct PlannerOptions {
   double interp_window_m = 3.0;   // the space-time solve's disc around the robot
   InterpolationMode interp = InterpolationMode::kSpaceTime;
   bool topology_routing = true;
+  // X8 (d): cancel wedge-trisector pairs meeting eq. 6 in every key frame before interpolation.
+  bool topology_control = false;
   CameraMode camera = CameraMode::kOptimized;
   double gain_threshold = 0.01;      // X L229
   double clearance_margin_m = 0.05;  // beyond the robot radius, as the host's own routes keep
@@ -113,6 +116,7 @@ struct StepDiagnostics {
   int pathlines = 0;        // cumulative
   int branch_choices = 0;   // cumulative
   int skeleton_routes = 0;  // cumulative: global routes over the skeleton
+  int cancelled_pairs = 0;  // cumulative: wedge-trisector pairs cancelled (topology_control)
   int substep = 0;
   bool keyframe = false;
   StepMode mode = StepMode::kNone;
@@ -160,6 +164,7 @@ class RobotPlanner {
   void BuildKeyFrame(const FloorInput& floor, const RobotInput& robot, double t_s, StepOutput* out);
   void BuildTopology(const RobotInput& robot, const ViewGain& gain, StepOutput* out);
   void AddGlyphs(const TensorRaster& frame, StepOutput* out) const;
+  SkeletonParams SkeletonFor(const RobotInput& robot) const;
   Pathline Advect(const RobotInput& robot, double heading_rad, double length_m,
                   const std::vector<DegeneratePoint>& points) const;
   bool Traversable(const Eigen::Vector2d& p, double radius_m) const;
@@ -210,6 +215,7 @@ class RobotPlanner {
   int fallback_routes_ = 0;
   int branch_choices_ = 0;
   int skeleton_routes_ = 0;
+  int cancelled_pairs_ = 0;
   std::vector<Eigen::Vector2d> skeleton_goals_;  // edge points routed to: not targets again
 };
 

@@ -37,6 +37,7 @@ PlannerOptions ReadOptions(const std::string& json_text) {
                  ? InterpolationMode::kLinear
                  : InterpolationMode::kSpaceTime;
   o.topology_routing = json.Flag("topology_routing", o.topology_routing);
+  o.topology_control = json.Flag("topology_control", o.topology_control);
   const std::string camera =
       json.Choice("camera", "optimized", {"optimized", "fixed", "no_linear", "no_angular"});
   o.camera = camera == "fixed"        ? CameraMode::kFixed
@@ -184,6 +185,7 @@ class TensorfieldPlanner : public vp::Planner {
     out.Diagnostic("pathlines" + s, d.pathlines);
     out.Diagnostic("branch_choices" + s, d.branch_choices);
     out.Diagnostic("skeleton_routes" + s, d.skeleton_routes);
+    if (options_.topology_control) out.Diagnostic("cancelled_pairs" + s, d.cancelled_pairs);
     out.Diagnostic("settled_goals" + s, d.settled_goals);
     out.Diagnostic("mode" + s, double(d.mode));
     out.Diagnostic("stop" + s, d.stop);
