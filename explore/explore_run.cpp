@@ -164,6 +164,12 @@ std::vector<std::string> Warnings(const ExploreResult& r, double plan_budget_s) 
   if (r.rejected_tasks > 0)
     warnings.push_back("the planner's output was rejected " + std::to_string(r.rejected_tasks) +
                        " times (reasons in plan_log.txt)");
+  if (r.camera_position_clamped_workspace + r.camera_position_clamped_speed > 0)
+    warnings.push_back("the arm camera's trajectory positions were moved into its workspace " +
+                       std::to_string(r.camera_position_clamped_workspace) +
+                       " times and held back by its speed " +
+                       std::to_string(r.camera_position_clamped_speed) +
+                       " times (the first of each in plan_log.txt)");
   return warnings;
 }
 
@@ -256,6 +262,7 @@ Result<ExploreRunReport> RunExploreExperiment(const ExploreRunParams& params,
   if (!probe_points.ok()) return probe_points.status().Naming(params.scene);
   report.setup_ms = clock.ElapsedMs();
   report.world_name = world->name;
+  report.scene_floor_z_m = world->source_floor_z_m;
   report.planner_name = planner.name();
 
   if (observer.started) observer.started(world->name);

@@ -54,6 +54,10 @@ inline constexpr float kObjectExtraThreshold_m = 0.05f;
 struct ExploreRunReport {
   std::string world_name;
   std::string planner_name;
+  // The scene file's z of the run's floor (World::source_floor_z_m): every position of the run
+  // (mesh.ply, run_log.csv, the maps) is the file's moved down by it. 0 unless the load was
+  // asked to move the floor (SceneLoadOptions::floor_z_m, detect_floor).
+  float scene_floor_z_m = 0.0f;
   ExploreResult loop;      // the loop's result, final maps included
   Mesh mesh;               // the fused map's final mesh (mesh.ply)
   MeshEvalResult quality;  // all zero when the mesh is empty

@@ -460,6 +460,10 @@ Result<World> LoadWorld(const std::string& path, const SceneLoadOptions& options
     return InvalidArgument("scale must be a positive number, got " + FormatNumber(options.scale));
   if (!(options.min_extent_m > 0.0f && options.max_extent_m > options.min_extent_m))
     return InvalidArgument("scene extent limits must satisfy 0 < min < max");
+  if (!(std::isfinite(options.floor_z_m) && std::abs(options.floor_z_m) <= options.max_extent_m))
+    return InvalidArgument("floor height must be a number within +-" +
+                           FormatMetres(options.max_extent_m) + " m, got " +
+                           FormatNumber(options.floor_z_m));
   std::error_code ec;
   if (!fs::exists(path, ec)) return NotFound("no such scene file: " + path);
   if (!fs::is_regular_file(path, ec)) return InvalidArgument("not a file: " + path);
@@ -517,6 +521,17 @@ Result<World> LoadWorld(const std::string& path, const SceneLoadOptions& options
         FormatMetres(options.max_extent_m) + " m across: wrong --scale or units" +
         (extent > options.max_extent_m ? " (a house 1 km wide?)" : " (a house 2 cm wide?)") +
         ", or wrong --up");
+  float floor_z = options.floor_z_m;
+  if (options.detect_floor) {
+    Result<FloorDetection> found = DetectFloor(world.mesh, options.floor_detect);
+    if (!found.ok())
+      return Status(found.status().code(), "scene " + path + ": " + found.status().message() +
+                                               "; give its floor height instead of detecting it");
+    floor_z = found->z_m;
+  }
+  world.source_floor_z_m = floor_z;
+  if (floor_z != 0.0f)
+    for (Eigen::Vector3f& p : world.mesh.positions) p.z() -= floor_z;
 
   const size_t num_tri = world.mesh.triangles.size();
   world.triangle_instance.assign(num_tri, kNoInstance);
@@ -534,7 +549,11 @@ Result<World> LoadWorld(const std::string& path, const SceneLoadOptions& options
       inst.id = row.id;
       inst.class_name = row.class_name;
       inst.model = row.model;
-      inst.bounds_W = row.bounds;
+      inst.bounds_W = row.bounds;  // as the table has it (ComputeInstanceBounds redoes most)
+      if (!inst.bounds_W.isEmpty() && floor_z != 0.0f) {
+        inst.bounds_W.min().z() -= floor_z;
+        inst.bounds_W.max().z() -= floor_z;
+      }
       for (long long k = 0; k < row.triangles; ++k) world.triangle_instance[t++] = row.id;
       world.instances.push_back(std::move(inst));
       max_id = std::max(max_id, row.id);

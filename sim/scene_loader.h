@@ -14,6 +14,13 @@
 //  3. a single mesh and no table: no instances (every triangle kNoInstance).
 // Rooms come from `<stem>_rooms.tsv` when present (WriteWorld writes one for generated worlds).
 //
+// Floor: the simulator puts the floor at z = 0. A scene whose floor lies elsewhere (Replica's
+// office at z = -1.17) is moved down by its floor height, after the up axis and the scale: by
+// SceneLoadOptions::floor_z_m, or by the height DetectFloor (sim/floor_detect.h) finds with
+// detect_floor. The mesh and the instances' boxes follow (room footprints are 2-D);
+// World::source_floor_z_m keeps the height, so a point of the world is the file's point minus (0,
+// 0, source_floor_z_m).
+//
 // Classes: a table's `class` column; else the furniture index (objects/aws_furniture_index.tsv,
 // found by walking up from the scene file, or SceneLoadOptions::furniture_index) `category` of
 // the row's model, with the index's "structure" split into wall / floor / ceiling / door /
@@ -24,6 +31,7 @@
 
 #include "core/status.h"
 #include "io/mesh_io.h"
+#include "sim/floor_detect.h"
 #include "sim/world.h"
 
 namespace voxplan {
@@ -38,6 +46,12 @@ struct SceneLoadOptions {
   // unit is wrong (a house 1 km wide, a kitchen 2 cm wide) and the scene is refused.
   float max_extent_m = 200.0f;
   float min_extent_m = 0.5f;
+  // The file's floor height (metres, after up and scale): the world is moved down by it. With
+  // detect_floor, DetectFloor(floor_detect) finds it instead, and a scene without a floor it can
+  // find is refused. |floor_z_m| must not exceed max_extent_m.
+  float floor_z_m = 0.0f;
+  bool detect_floor = false;
+  FloorDetectParams floor_detect;
 };
 
 Result<World> LoadWorld(const std::string& path, const SceneLoadOptions& options = {});

@@ -32,6 +32,9 @@ struct World {
   std::vector<uint32_t> triangle_instance;  // one per mesh triangle; kNoInstance where none
   std::vector<Instance> instances;          // sorted by id
   std::vector<Room> rooms;                  // empty unless the world was generated
+  // The source file's z of this world's floor (z = 0): LoadWorld moved the file's geometry down
+  // by it (SceneLoadOptions::floor_z_m, detect_floor). 0 for generated worlds.
+  float source_floor_z_m = 0.0f;
 };
 
 }  // namespace voxplan

@@ -27,12 +27,31 @@ void AddSceneFrameOptions(CLI::App* sub, SceneFrameOptions& frame) {
   sub->add_option("--scale", frame.scale, "Scene scale to metres")
       ->check(InRange(1e-6, 1e6))
       ->capture_default_str();
+  sub->add_option("--floor-z", frame.floor_z,
+                  "Height of the scene's floor (m, after --up and --scale), or auto: the lowest "
+                  "large upward-facing surface; the world is moved down by it so its floor lies "
+                  "at z = 0")
+      ->check(CLI::Validator(
+          [](std::string& text) -> std::string {
+            if (text == "auto") return {};
+            double v = 0.0;
+            if (!CLI::detail::lexical_cast(text, v) || !std::isfinite(v) ||
+                std::abs(v) > kMaxFloorZ_m)
+              return "must be auto or a height in metres within +-" +
+                     std::to_string(int(kMaxFloorZ_m)) + ", got " + text;
+            return {};
+          },
+          "auto|M"))
+      ->capture_default_str();
 }
 
 SceneLoadOptions SceneLoad(const SceneFrameOptions& frame) {
   SceneLoadOptions load;
   load.scale = float(frame.scale);
   load.up = (frame.up == "y" || frame.up == "Y") ? UpAxis::kY : UpAxis::kZ;
+  // The option's validator has checked the text: "auto" or a bounded number.
+  load.detect_floor = frame.floor_z == "auto";
+  if (!load.detect_floor) load.floor_z_m = std::strtof(frame.floor_z.c_str(), nullptr);
   return load;
 }
 

@@ -72,11 +72,15 @@ CLI::Validator MeshOutputValidator();
 CLI::Validator Positive();
 CLI::Validator NonNegative();
 
-// --up and --scale of a scene file: worlds are Z-up metres unless these say otherwise.
+// --up, --scale and --floor-z of a scene file: worlds are Z-up metres with the floor at z = 0
+// unless these say otherwise. --floor-z is the file's floor height (metres after up and scale)
+// or "auto" (DetectFloor, sim/floor_detect.h); the world is moved down by it (SceneLoadOptions).
 struct SceneFrameOptions {
   std::string up = "z";
   double scale = 1.0;
+  std::string floor_z = "0";  // "auto" or metres within +-kMaxFloorZ_m
 };
+inline constexpr double kMaxFloorZ_m = 100.0;
 void AddSceneFrameOptions(CLI::App* sub, SceneFrameOptions& frame);
 // The load options they ask for (the rest at their defaults).
 SceneLoadOptions SceneLoad(const SceneFrameOptions& frame);

@@ -143,6 +143,8 @@ int RunSimScene(const SimSceneOptions& o) {
     j["scene"] = o.scene;
     j["scale"] = o.frame.scale;
     j["up"] = o.frame.up;
+    // The file's floor height the world was moved down by; only with --floor-z, as asked.
+    if (o.frame.floor_z != "0") j["floor_z_m"] = double(world->source_floor_z_m);
   }
   j["out"] = o.out_dir;
   j["area_m2"] = RoundTo(inside_cells * cell_area, 2);  // floor plan: everything not outside

@@ -13,6 +13,7 @@
 #include "explore/explore_run.h"
 #include "explore/robot_config.h"
 #include "explore/run_outputs.h"
+#include "tests/explore/explore_test_runs.h"
 #include "tests/support/test_support.h"
 
 namespace voxplan {
@@ -20,27 +21,12 @@ namespace {
 
 namespace fs = std::filesystem;
 
-std::unique_ptr<LoadedPlanner> Greedy() {
-  Result<std::unique_ptr<LoadedPlanner>> planner =
-      LoadPlanner(VOXPLAN_EXPLORE_TEST_PLANNER,
-                  {.config_json = "{}", .seed = 5, .search_path = {}, .limits = {}});
-  EXPECT_TRUE(planner.ok()) << planner.status().message();
-  return planner.ok() ? std::move(planner).value() : nullptr;
-}
+std::unique_ptr<LoadedPlanner> Greedy() { return test::GreedyPlanner(); }
 
 // 60 simulated seconds, coarse, two robots: a few seconds of wall time.
 ExploreRunParams ShortRun(const fs::path& out) {
-  ExploreRunParams p;
-  p.scene = "apartment:size=S,seed=1";
-  p.robots = 2;
-  p.explore.voxel_size_m = 0.1f;
-  p.explore.image_width = 160;
-  p.explore.image_height = 120;
-  p.explore.max_time_s = 60.0;
-  p.explore.seed = 5;
+  ExploreRunParams p = test::CoarseRun("apartment:size=S,seed=1", 2, 60.0, out);
   p.explore.progress_interval_s = 10.0;
-  p.eval_samples_per_m2 = 50.0;
-  p.out_dir = out.string();
   return p;
 }
 

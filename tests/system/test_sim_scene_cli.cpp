@@ -59,6 +59,39 @@ TEST(SimSceneCli, LoadsTheAwsHouseWithItsInstances) {
   EXPECT_EQ(back->instances.size(), 85u);
 }
 
+TEST(SimSceneCli, FloorZMovesTheReplicaOfficeFloorToZero) {
+  // Replica's office stands on a floor at z = -1.13: as it is, nothing lies in the floor plan's
+  // floor band (no free cell); with --floor-z auto, or that height given, the room is free floor.
+  test::TempDir dir("sim_scene_floor");
+  const std::string scene =
+      (test::SharedDataDir() / "scenes/replica_office0/office0_mesh.ply").string();
+  auto run = [&](const std::vector<std::string>& extra, const std::string& sub) {
+    std::vector<std::string> args = {
+        "sim", "scene", "--scene", scene, "--out", (dir / sub).string(), "--no-glb"};
+    args.insert(args.end(), extra.begin(), extra.end());
+    return RunCli(args);
+  };
+  const RunResult as_is = run({}, "as_is");
+  ASSERT_EQ(as_is.exit_code, 0) << Describe(as_is);
+  EXPECT_EQ(as_is.last_json["free_area_m2"].get<double>(), 0.0);
+  EXPECT_FALSE(as_is.last_json.contains("floor_z_m"));
+  const RunResult detected = run({"--floor-z", "auto"}, "auto");
+  ASSERT_EQ(detected.exit_code, 0) << Describe(detected);
+  const double floor_z = detected.last_json["floor_z_m"].get<double>();
+  EXPECT_NEAR(floor_z, -1.124, 0.02);
+  EXPECT_GT(detected.last_json["free_area_m2"].get<double>(), 5.0);  // of 18.6 m² inside
+  const RunResult given = run({"--floor-z", "-1.129675"}, "given");
+  ASSERT_EQ(given.exit_code, 0) << Describe(given);
+  EXPECT_NEAR(given.last_json["floor_z_m"].get<double>(), -1.129675, 1e-6);
+  EXPECT_EQ(given.last_json["free_area_m2"], detected.last_json["free_area_m2"]);
+  // The written world is the moved one: its floor at 0.
+  Result<World> back = LoadWorld((dir / "auto" / "world.ply").string());
+  ASSERT_TRUE(back.ok()) << back.status().message();
+  Result<FloorDetection> f = DetectFloor(back->mesh);
+  ASSERT_TRUE(f.ok()) << f.status().message();
+  EXPECT_NEAR(f->z_m, 0.0f, 1e-5f);
+}
+
 TEST(SimSceneCli, UsageErrorsExitTwoAndWriteNothing) {
   test::TempDir dir("sim_scene_bad");
   const std::string scene =
@@ -71,6 +104,9 @@ TEST(SimSceneCli, UsageErrorsExitTwoAndWriteNothing) {
       {"sim", "scene", "--generate", "apartment", "--scene", scene, "--out", out},
       {"sim", "scene", "--scene", scene, "--scale", "1000", "--out", out},
       {"sim", "scene", "--scene", scene, "--up", "x", "--out", out},
+      {"sim", "scene", "--scene", scene, "--floor-z", "floor", "--out", out},
+      {"sim", "scene", "--scene", scene, "--floor-z", "1e9", "--out", out},
+      {"sim", "scene", "--scene", scene, "--floor-z", "nan", "--out", out},
       {"sim", "scene", "--generate", "apartment", "--out", (dir / "no/such/dir").string()},
   };
   for (const auto& args : cases) {
