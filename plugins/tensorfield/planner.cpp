@@ -113,6 +113,7 @@ void RobotPlanner::BuildKeyFrame(const FloorInput& floor, const RobotInput& robo
                                                                   VectorConstraint::kTangent, kp))
                              .size());
   }
+  const double t_control = NowMs();
   if (options_.topology_control && options_.field == FieldKind::kTensor) {
     // X8 (d) on the key frame, before the frames between key frames are interpolated from it.
     TopologyParams tp;
@@ -121,7 +122,37 @@ void RobotPlanner::BuildKeyFrame(const FloorInput& floor, const RobotInput& robo
     AdvectionObstacles obstacles;
     obstacles.clearance = &window_.clearance;
     const Skeleton skeleton = ExtractSkeleton(next, points, SkeletonFor(robot), obstacles);
-    cancelled_pairs_ += CancelDegeneratePairs(&next, points, skeleton, window_.clearance).cancelled;
+    const int cancelled =
+        CancelDegeneratePairs(&next, points, skeleton, window_.clearance).cancelled;
+    cancelled_pairs_ += cancelled;
+    // X8 (a)-(c) on the points the cancellations left.
+    std::vector<DegeneratePoint> left;
+    Skeleton left_skeleton;
+    if (cancelled > 0) {
+      left = FindDegeneratePoints(next, tp);
+      left_skeleton = ExtractSkeleton(next, left, SkeletonFor(robot), obstacles);
+    }
+    const ViewGain gain = GainModel(robot);
+    // (b)'s "no more information after a round trip": the robot has passed within
+    // kVisitRadiusM of the wedge, and its end separatrix carries no gain.
+    const ExhaustedEndFn exhausted = [&](const DegeneratePoint& wedge, const SkeletonEdge& edge) {
+      const bool visited = std::any_of(trail_.begin(), trail_.end(), [&](const Eigen::Vector2d& p) {
+        return (p - wedge.position_m).norm() <= kVisitRadiusM;
+      });
+      return visited &&
+             MeanAlongPolyline(
+                 edge.polyline, [&](const Eigen::Vector2d& p) { return gain.PointGain(p); }, 0.3) <
+                 options_.gain_threshold;
+    };
+    PointMovesParams mp;
+    mp.robot_radius_m = robot.radius_m;
+    mp.trace = SkeletonFor(robot);
+    const PointMovesResult moved = MoveDegeneratePoints(&next, cancelled > 0 ? left : points,
+                                                        cancelled > 0 ? left_skeleton : skeleton,
+                                                        window_.clearance, exhausted, mp);
+    corner_wedges_ += moved.corner_wedges;
+    retracted_wedges_ += moved.retracted_wedges;
+    moved_trisectors_ += moved.moved_trisectors;
   }
   const double t_census = NowMs();
   frames_.clear();
@@ -148,7 +179,8 @@ void RobotPlanner::BuildKeyFrame(const FloorInput& floor, const RobotInput& robo
   out->diag.keyframe = true;
   out->diag.field_ms = t1 - t0;
   out->diag.interp_ms = NowMs() - t_census;
-  out->diag.census_ms = t_census - t1;
+  out->diag.census_ms = t_control - t1;
+  out->diag.control_ms = t_census - t_control;
 }
 
 void RobotPlanner::BuildTopology(const RobotInput& robot, const ViewGain& gain, StepOutput* out) {
@@ -409,12 +441,28 @@ void RobotPlanner::SettleAround(const FloorInput& floor, const Eigen::Vector2d& 
   visited_goals_.push_back(goal);
 }
 
+// The gain model on the current window; settled cells count as seen.
+ViewGain RobotPlanner::GainModel(const RobotInput& robot) const {
+  std::vector<std::uint8_t> codes = window_.codes;
+  for (int i = 0; i < window_.geometry.NumCells() && !settled_.empty(); ++i)
+    if (settled_.count(KeyOf(window_.geometry, i)) > 0)
+      codes[static_cast<std::size_t>(i)] = kFloorFree;
+  GainParams gp;
+  gp.range_m = robot.max_range_m;
+  gp.near_m = std::max(0.3, robot.min_range_m);
+  gp.fov_rad = robot.fov_rad;
+  return ViewGain(window_.geometry, std::move(codes), gp);
+}
+
 StepOutput RobotPlanner::Step(const FloorInput& floor, const RobotInput& robot, double sim_time_s,
                               const RouteServices& services) {
   StepOutput out;
   out.wakeup_t_s = sim_time_s + options_.substep_s;
   history_.push_back(robot.position_m);
   if (history_.size() > 32) history_.erase(history_.begin());
+  if (options_.topology_control &&
+      (trail_.empty() || (trail_.back() - robot.position_m).norm() >= kTrailSpacingM))
+    trail_.push_back(robot.position_m);
 
   // Key frame when due (every substeps_per_keyframe sub-steps, or the robot nears the window's
   // edge), else the current window re-read on the key frame's grid.
@@ -434,16 +482,7 @@ StepOutput RobotPlanner::Step(const FloorInput& floor, const RobotInput& robot, 
                              : std::clamp(first + elapsed, 0, static_cast<int>(frames_.size()) - 1);
   out.diag.substep = sub_;
 
-  // The gain model on the current window; settled cells count as seen.
-  std::vector<std::uint8_t> codes = window_.codes;
-  for (int i = 0; i < window_.geometry.NumCells() && !settled_.empty(); ++i)
-    if (settled_.count(KeyOf(window_.geometry, i)) > 0)
-      codes[static_cast<std::size_t>(i)] = kFloorFree;
-  GainParams gp;
-  gp.range_m = robot.max_range_m;
-  gp.near_m = std::max(0.3, robot.min_range_m);
-  gp.fov_rad = robot.fov_rad;
-  const ViewGain gain(window_.geometry, std::move(codes), gp);
+  const ViewGain gain = GainModel(robot);
 
   const double topo_t0 = NowMs();
   if (due) BuildTopology(robot, gain, &out);
@@ -472,6 +511,9 @@ StepOutput RobotPlanner::Step(const FloorInput& floor, const RobotInput& robot, 
     out.diag.branch_choices = branch_choices_;
     out.diag.skeleton_routes = skeleton_routes_;
     out.diag.cancelled_pairs = cancelled_pairs_;
+    out.diag.corner_wedges = corner_wedges_;
+    out.diag.retracted_wedges = retracted_wedges_;
+    out.diag.moved_trisectors = moved_trisectors_;
     out.diag.settled_goals = static_cast<int>(visited_goals_.size());
     return std::move(out);
   };

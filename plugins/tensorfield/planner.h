@@ -47,7 +47,9 @@ struct PlannerOptions {
   double interp_window_m = 3.0;   // the space-time solve's disc around the robot
   InterpolationMode interp = InterpolationMode::kSpaceTime;
   bool topology_routing = true;
-  // X8 (d): cancel wedge-trisector pairs meeting eq. 6 in every key frame before interpolation.
+  // X8 in every key frame before interpolation: (d) cancel wedge-trisector pairs meeting eq. 6,
+  // then (a) move corner wedges into their corners, (b) retract exhausted end wedges, (c) move
+  // trisectors off obstacles (topology_control.h).
   bool topology_control = false;
   CameraMode camera = CameraMode::kOptimized;
   double gain_threshold = 0.01;      // X L229
@@ -117,6 +119,9 @@ struct StepDiagnostics {
   int branch_choices = 0;   // cumulative
   int skeleton_routes = 0;  // cumulative: global routes over the skeleton
   int cancelled_pairs = 0;  // cumulative: wedge-trisector pairs cancelled (topology_control)
+  int corner_wedges = 0;    // cumulative, topology_control: X8 (a), (b) and (c) moves
+  int retracted_wedges = 0;
+  int moved_trisectors = 0;
   int substep = 0;
   bool keyframe = false;
   StepMode mode = StepMode::kNone;
@@ -126,6 +131,7 @@ struct StepDiagnostics {
   // blend, unfilled) and the normal- and tangent-oriented vector fields' singularities.
   int census_degenerate = -1, census_vector_normal = -1, census_vector_tangent = -1;
   double census_ms = -1.0;
+  double control_ms = -1.0;  // key-frame calls: topology control (0 when off)
 };
 
 struct StepOutput {
@@ -165,6 +171,7 @@ class RobotPlanner {
   void BuildTopology(const RobotInput& robot, const ViewGain& gain, StepOutput* out);
   void AddGlyphs(const TensorRaster& frame, StepOutput* out) const;
   SkeletonParams SkeletonFor(const RobotInput& robot) const;
+  ViewGain GainModel(const RobotInput& robot) const;
   Pathline Advect(const RobotInput& robot, double heading_rad, double length_m,
                   const std::vector<DegeneratePoint>& points) const;
   bool Traversable(const Eigen::Vector2d& p, double radius_m) const;
@@ -216,6 +223,10 @@ class RobotPlanner {
   int branch_choices_ = 0;
   int skeleton_routes_ = 0;
   int cancelled_pairs_ = 0;
+  int corner_wedges_ = 0, retracted_wedges_ = 0, moved_trisectors_ = 0;
+  // topology_control: the robot's positions at least kTrailSpacingM apart, for (b)'s visits.
+  static constexpr double kTrailSpacingM = 0.25, kVisitRadiusM = 1.0;
+  std::vector<Eigen::Vector2d> trail_;
   std::vector<Eigen::Vector2d> skeleton_goals_;  // edge points routed to: not targets again
 };
 

@@ -165,6 +165,7 @@ class TensorfieldPlanner : public vp::Planner {
       out.Diagnostic("field_ms" + s, d.field_ms);
       out.Diagnostic("interp_ms" + s, d.interp_ms);
       out.Diagnostic("census_ms" + s, d.census_ms);
+      if (options_.topology_control) out.Diagnostic("control_ms" + s, d.control_ms);
       out.Diagnostic("census_degenerate" + s, d.census_degenerate);
       out.Diagnostic("census_vector_normal" + s, d.census_vector_normal);
       out.Diagnostic("census_vector_tangent" + s, d.census_vector_tangent);
@@ -185,7 +186,12 @@ class TensorfieldPlanner : public vp::Planner {
     out.Diagnostic("pathlines" + s, d.pathlines);
     out.Diagnostic("branch_choices" + s, d.branch_choices);
     out.Diagnostic("skeleton_routes" + s, d.skeleton_routes);
-    if (options_.topology_control) out.Diagnostic("cancelled_pairs" + s, d.cancelled_pairs);
+    if (options_.topology_control) {
+      out.Diagnostic("cancelled_pairs" + s, d.cancelled_pairs);
+      out.Diagnostic("corner_wedges" + s, d.corner_wedges);
+      out.Diagnostic("retracted_wedges" + s, d.retracted_wedges);
+      out.Diagnostic("moved_trisectors" + s, d.moved_trisectors);
+    }
     out.Diagnostic("settled_goals" + s, d.settled_goals);
     out.Diagnostic("mode" + s, double(d.mode));
     out.Diagnostic("stop" + s, d.stop);

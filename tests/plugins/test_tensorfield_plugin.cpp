@@ -1,7 +1,8 @@
 // The tensorfield planner plugin (Xu 2017) through the host, on grid worlds: options refused by
 // key and range, the first call's continuous path in free space with a call asked one sub-step
 // later, a corridor followed along its direction over a short simulated loop, termination only
-// once no frontier is left, the fixed camera looking along the path, determinism.
+// once no frontier is left, the fixed camera looking along the path, determinism; topology
+// control's counters.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -208,6 +209,38 @@ TEST(Tensorfield, TheFixedCameraLooksAlongThePathAndPlansAreDeterministic) {
   ASSERT_EQ(a.robots[0].camera_trajectory.size(), b.robots[0].camera_trajectory.size());
   for (size_t i = 0; i < a.robots[0].camera_trajectory.size(); ++i)
     EXPECT_EQ(a.robots[0].camera_trajectory[i].yaw_rad, b.robots[0].camera_trajectory[i].yaw_rad);
+}
+
+TEST(Tensorfield, TopologyControlReportsItsWorkAndKeepsThePathInFreeSpace) {
+  // Rooms joined by doors, partly unknown: key frames with corners and doorways. With
+  // topology_control the moves and cancellations are counted (cumulative, never decreasing) and
+  // the path stays where the robot may stand; without it the counters are not reported.
+  test::RasterWorld world = test::ApartmentWorld(8.f, 6.f, 0.05f, 1, 5.f, 3.f);
+  auto controlled = Load(R"({"topology_control": true})");
+  auto plain = Load();
+  ASSERT_TRUE(controlled && plain);
+  double last_total = 0.0;
+  for (int call = 0; call < 6; ++call) {
+    const PlanResult r = MustPlan(*controlled, world, At(5.0 + 0.4 * call));
+    double total = 0.0;
+    for (const char* name :
+         {"cancelled_pairs", "corner_wedges", "retracted_wedges", "moved_trisectors"}) {
+      const double v = Diagnostic(r, name);
+      ASSERT_FALSE(std::isnan(v)) << name;
+      EXPECT_GE(v, 0.0) << name;
+      total += v;
+    }
+    EXPECT_GE(total, last_total) << "call " << call;
+    last_total = total;
+    if (Diagnostic(r, "keyframe") == 1.0) {
+      EXPECT_GE(Diagnostic(r, "control_ms"), 0.0);
+    }
+    for (const PathPoint& p : r.robots[0].path)
+      EXPECT_TRUE(Traversable(world, p.position_m, 0.18f)) << p.position_m.transpose();
+    const PlanResult q = MustPlan(*plain, world, At(5.0 + 0.4 * call));
+    EXPECT_TRUE(std::isnan(Diagnostic(q, "corner_wedges")));
+    EXPECT_TRUE(std::isnan(Diagnostic(q, "control_ms")));
+  }
 }
 
 }  // namespace

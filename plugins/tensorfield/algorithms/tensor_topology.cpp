@@ -146,7 +146,9 @@ std::vector<double> SeparatrixAngles(const Eigen::Matrix2d& jacobian, int scan_s
   double g0 = cross(0.0);
   for (int k = 0; k < steps; ++k) {
     const double a = k * step, b = (k + 1) * step;
-    const double g1 = cross(b);
+    // The last interval ends where the first starts: a root at φ = 0 is found once, whichever
+    // side of it rounding puts cross(0) and cross(2π).
+    const double g1 = k + 1 < steps ? cross(b) : cross(0.0);
     double root = -1.0;
     if (g0 == 0.0) {
       root = a;

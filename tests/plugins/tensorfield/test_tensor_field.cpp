@@ -338,5 +338,19 @@ TEST(VectorBaselines, FurnishedRoomHasFewerDegeneratePointsThanVectorSingulariti
       << tensor_points << " vs " << tangent_points;
 }
 
+TEST(TensorTopology, FindsASeparatrixAtTheScanOriginWhicheverSideRoundingPutsIt) {
+  // τ = J r with J = [[1, 0], [δ, -1]]: a trisector with radial directions near 0°, 120° and
+  // 240°; for tiny δ the first lies within rounding of φ = 0, just below or just above it.
+  for (const double delta : {-3e-16, 0.0, 3e-16}) {
+    Eigen::Matrix2d j;
+    j << 1.0, 0.0, delta, -1.0;
+    const std::vector<double> angles = SeparatrixAngles(j);
+    ASSERT_EQ(angles.size(), 3u) << "delta " << delta;
+    int near_zero = 0;
+    for (const double a : angles) near_zero += std::min(a, 2.0 * M_PI - a) < 1e-6 ? 1 : 0;
+    EXPECT_EQ(near_zero, 1) << "delta " << delta;
+  }
+}
+
 }  // namespace
 }  // namespace voxplan::tensorfield
