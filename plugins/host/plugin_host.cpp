@@ -9,6 +9,7 @@
 #include <cstring>
 #include <set>
 #include <system_error>
+#include <utility>
 
 #include "plugins/host/elf_check.h"
 #include "plugins/host/host_internal.h"
@@ -16,6 +17,9 @@
 
 #ifndef VOXPLAN_PLANNER_BUILD_DIR
 #define VOXPLAN_PLANNER_BUILD_DIR ""
+#endif
+#ifndef VOXPLAN_PLANNER_INSTALL_REL_DIR
+#define VOXPLAN_PLANNER_INSTALL_REL_DIR ""
 #endif
 
 namespace voxplan {
@@ -60,6 +64,17 @@ struct LibraryGuard {
   }
 };
 
+// The installed planner folder beside the running executable (bin/voxplan ->
+// lib/voxplan/planners), or empty when there is none: an executable in the build tree.
+fs::path InstalledPlannerDir() {
+  if (!*VOXPLAN_PLANNER_INSTALL_REL_DIR) return {};
+  std::error_code ec;
+  const fs::path exe = fs::read_symlink("/proc/self/exe", ec);
+  if (ec) return {};
+  const fs::path dir = (exe.parent_path() / VOXPLAN_PLANNER_INSTALL_REL_DIR).lexically_normal();
+  return fs::is_directory(dir, ec) ? dir : fs::path();
+}
+
 }  // namespace
 
 std::vector<fs::path> DefaultPlannerSearchPath() {
@@ -73,7 +88,12 @@ std::vector<fs::path> DefaultPlannerSearchPath() {
       begin = end + 1;
     }
   }
-  if (*VOXPLAN_PLANNER_BUILD_DIR) path.emplace_back(VOXPLAN_PLANNER_BUILD_DIR);
+  // An installed executable never looks into the build tree it came from.
+  if (fs::path installed = InstalledPlannerDir(); !installed.empty()) {
+    path.push_back(std::move(installed));
+  } else if (*VOXPLAN_PLANNER_BUILD_DIR) {
+    path.emplace_back(VOXPLAN_PLANNER_BUILD_DIR);
+  }
   return path;
 }
 

@@ -6,8 +6,9 @@
 //   Result<PlanResult> plan = (*planner)->Plan(world, {.event = PlanEvent::kStart});
 //
 // A name is looked up as libvoxplan_planner_<name>.so in the search path: $VOXPLAN_PLANNER_PATH
-// (colon-separated) first, then the folder the build puts planners in. The host refuses, with a
-// Status and never a crash, a file it cannot dlopen, a missing entry symbol, another ABI
+// (colon-separated) first, then the folder the build puts planners in, or for an installed
+// executable the installed planners (lib/voxplan/planners beside its bin/). The host refuses,
+// with a Status and never a crash, a file it cannot dlopen, a missing entry symbol, another ABI
 // version, a table of the wrong size and a failing create; and, before dlopen, a file that is
 // not a whole shared object for this machine (plugins/host/elf_check.h). The plugin's output is
 // validated against the world: non-finite numbers, tasks outside the bounds, in or too near an
@@ -75,7 +76,8 @@ struct PlannerLoadOptions {
   PlannerLimits limits;
 };
 
-// $VOXPLAN_PLANNER_PATH entries, then the build's planner folder.
+// $VOXPLAN_PLANNER_PATH entries, then the installed planner folder beside the running executable
+// (../lib/voxplan/planners from its bin/) where that exists, else the build's planner folder.
 std::vector<std::filesystem::path> DefaultPlannerSearchPath();
 // Names of the libvoxplan_planner_<name>.so files in the folders, sorted, without duplicates.
 std::vector<std::string> AvailablePlanners(const std::vector<std::filesystem::path>& search_path);
