@@ -18,6 +18,7 @@
 #include "sim/raycaster.h"
 #include "sim/robot.h"
 #include "sim/tour.h"
+#include "sim/world_io.h"
 
 namespace voxplan {
 
@@ -249,6 +250,9 @@ Result<ExploreRunReport> RunExploreExperiment(const ExploreRunParams& params,
   std::error_code ec;
   fs::create_directories(fs::path(params.out_dir), ec);
   if (ec) return IoError("cannot create output folder " + params.out_dir + ": " + ec.message());
+  // The world as run, first: the evaluation commands score against it (and check they do).
+  Result<WrittenWorld> written = WriteWorld(*world, params.out_dir, RunWorldFiles());
+  if (!written.ok()) return written.status();
 
   // Ground truth for completeness: the observable surface, sampled once for the time series.
   ExploreRunReport report;
@@ -263,6 +267,7 @@ Result<ExploreRunReport> RunExploreExperiment(const ExploreRunParams& params,
   report.setup_ms = clock.ElapsedMs();
   report.world_name = world->name;
   report.scene_floor_z_m = world->source_floor_z_m;
+  report.world_fingerprint = WorldFingerprintHex(*world);
   report.planner_name = planner.name();
 
   if (observer.started) observer.started(world->name);

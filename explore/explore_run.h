@@ -58,6 +58,9 @@ struct ExploreRunReport {
   // (mesh.ply, run_log.csv, the maps) is the file's moved down by it. 0 unless the load was
   // asked to move the floor (SceneLoadOptions::floor_z_m, detect_floor).
   float scene_floor_z_m = 0.0f;
+  // The world as run (WorldFingerprintHex, sim/world_io.h): metrics.json's world_fingerprint,
+  // which `eval run` and `eval objects` check a --scene against.
+  std::string world_fingerprint;
   ExploreResult loop;      // the loop's result, final maps included
   Mesh mesh;               // the fused map's final mesh (mesh.ply)
   MeshEvalResult quality;  // all zero when the mesh is empty

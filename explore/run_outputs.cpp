@@ -68,6 +68,7 @@ json MetricsObject(const ExploreRunParams& params, const ExploreRunReport& repor
   // file's z of the run's floor (a file point is a run point plus this in z; unrounded).
   if (params.scene_load.detect_floor || params.scene_load.floor_z_m != 0.f)
     m["scene_floor_z_m"] = double(report.scene_floor_z_m);
+  m["world_fingerprint"] = report.world_fingerprint;
   m["planner"] = report.planner_name;
   m["robots"] = params.robots;
   m["seed"] = params.explore.seed;
@@ -376,7 +377,41 @@ std::vector<std::string> RunOutputFiles(const std::string& out_dir) {
                            "plan_log.txt", "plan_calls.csv", "objects.csv", "robot.json",
                            "timeline.svg", "unobserved.svg", "topdown.png", "planner.png"})
     paths.push_back(InFolder(out_dir, name));
+  for (const std::string& p : WorldFilePaths(out_dir, RunWorldFiles())) paths.push_back(p);
   return paths;
+}
+
+WorldWriteOptions RunWorldFiles() {
+  WorldWriteOptions o;
+  o.basename = "world";
+  o.write_glb = false;  // world.ply holds the same mesh
+  return o;
+}
+
+Status CheckRunWorld(const std::string& run_file, const World& world) {
+  const fs::path metrics = fs::path(run_file).parent_path() / "metrics.json";
+  std::error_code ec;
+  if (!fs::is_regular_file(metrics, ec)) return Status::Ok();
+  constexpr uintmax_t kMaxMetricsBytes = 16u << 20;  // a run's metrics.json is a few kB
+  const uintmax_t bytes = fs::file_size(metrics, ec);
+  if (ec || bytes > kMaxMetricsBytes)
+    return InvalidArgument(metrics.string() + ": not a run's metrics.json (over 16 MiB)");
+  Result<std::string> text = ReadFileToString(metrics.string());
+  if (!text.ok()) return text.status();
+  const json m = json::parse(*text, nullptr, /*allow_exceptions=*/false);
+  if (!m.is_object()) return InvalidArgument("not a JSON object: " + metrics.string());
+  const auto it = m.find("world_fingerprint");
+  if (it == m.end() || !it->is_string())
+    return NotFound(metrics.string() +
+                    " records no world_fingerprint (a run from before it was"
+                    " recorded): cannot check the world is the run's");
+  const std::string ours = WorldFingerprintHex(world);
+  if (it->get<std::string>() == ours) return Status::Ok();
+  return InvalidArgument("the scene is not the world this run explored: world fingerprint " + ours +
+                         ", " + metrics.string() + " has " + it->get<std::string>() +
+                         " (score against " +
+                         (fs::path(run_file).parent_path() / "world.ply").string() +
+                         ", the world it wrote, or give the same --scene, seed and --floor-z)");
 }
 
 }  // namespace voxplan

@@ -17,6 +17,9 @@
 //   plan_calls.csv  one row per plan call with its wall time and the plugin's diagnostics
 //   robot.json      the robot and its modes as run (explore/robot_config.h: --robot-config)
 //   objects.csv     per object: completeness at 2 and 5 cm, accuracy (Guo 2022 eq. 6, 7)
+//   world.ply, world_instances.tsv, world_rooms.tsv (generated worlds), world_floor_plan.png
+//   and .yaml: the world as run (sim/world_io.h), written before the loop starts; metrics.json's
+//   world_fingerprint is its WorldFingerprintHex
 // Every error names the file it could not write. The report as JSON is here too, beside
 // metrics.json.
 #include <string>
@@ -25,6 +28,7 @@
 #include "core/mesh.h"
 #include "core/status.h"
 #include "explore/explore_run.h"
+#include "sim/world_io.h"
 
 namespace voxplan {
 
@@ -42,5 +46,14 @@ Status WriteRunOutputs(const ExploreRunParams& params, const ExploreRunReport& r
 
 // The paths of every file above in `out_dir`, for a caller to check against its inputs.
 std::vector<std::string> RunOutputFiles(const std::string& out_dir);
+// WriteWorld's options for the world files above.
+WorldWriteOptions RunWorldFiles();
+
+// Whether `world` is the world of the run that wrote `run_file` (a run_log.csv or mesh.ply in a
+// run's folder): OK when it is, or when the folder holds no metrics.json (not an explore run);
+// InvalidArgument, naming both fingerprints and the run's world file, when metrics.json's
+// world_fingerprint differs; NotFound when metrics.json has none (a run from before it was
+// recorded: the caller warns); the error of an unreadable metrics.json otherwise.
+Status CheckRunWorld(const std::string& run_file, const World& world);
 
 }  // namespace voxplan

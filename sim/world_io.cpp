@@ -83,6 +83,30 @@ World GroupTrianglesByInstance(const World& world) {
   return out;
 }
 
+uint64_t WorldFingerprint(const World& world) {
+  const World grouped = GroupTrianglesByInstance(world);
+  uint64_t h = 1469598103934665603ull;
+  const auto add = [&h](const void* data, size_t bytes) {
+    const auto* p = static_cast<const unsigned char*>(data);
+    for (size_t i = 0; i < bytes; ++i) h = (h ^ p[i]) * 1099511628211ull;
+  };
+  // Corner positions by value, not vertex indices: the PLY writer shares equal vertices.
+  const std::vector<Eigen::Vector3f>& p = grouped.mesh.positions;
+  for (size_t t = 0; t < grouped.mesh.triangles.size(); ++t) {
+    for (const uint32_t v : grouped.mesh.triangles[t])
+      if (v < p.size()) add(p[v].data(), 3 * sizeof(float));
+    add(&grouped.triangle_instance[t], sizeof(uint32_t));
+  }
+  return h;
+}
+
+std::string WorldFingerprintHex(const World& world) {
+  char text[17];
+  std::snprintf(text, sizeof text, "%016llx",
+                static_cast<unsigned long long>(WorldFingerprint(world)));
+  return text;
+}
+
 Status WriteInstanceTable(const World& world, const std::string& path) {
   std::map<uint32_t, size_t> count;
   for (uint32_t id : world.triangle_instance) ++count[id];

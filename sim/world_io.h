@@ -13,6 +13,7 @@
 //                               outside 128; image row 0 is the plan's largest y (north up)
 //   <name>_floor_plan.yaml      ROS map_server-style metadata: image, resolution, origin, band
 // Same World and options -> the same bytes in every file.
+#include <cstdint>
 #include <string>
 #include <vector>
 
@@ -47,6 +48,13 @@ std::vector<std::string> WorldFilePaths(const std::string& out_dir,
 // The world with its triangles reordered as WriteWorld stores them (grouped by instance in the
 // order of world.instances, kNoInstance last; order kept within a group); vertices untouched.
 World GroupTrianglesByInstance(const World& world);
+
+// FNV-1a (64 bit) over the world as WriteWorld stores it (GroupTrianglesByInstance): each
+// triangle's corner positions and instance id, in order. A world read back from WriteWorld's files
+// has the same; another seed, another furniture set or a moved floor has another.
+uint64_t WorldFingerprint(const World& world);
+// As 16 lower-case hex digits (metrics.json's world_fingerprint).
+std::string WorldFingerprintHex(const World& world);
 
 Status WriteInstanceTable(const World& world, const std::string& path);  // world grouped
 Status WriteRoomTable(const std::vector<Room>& rooms, const std::string& path);

@@ -13,6 +13,7 @@
 #include <sstream>
 
 #include "core/bounds.h"
+#include "explore/run_outputs.h"
 #include "io/file_util.h"
 #include "io/mesh_io.h"
 
@@ -73,6 +74,22 @@ Result<World> LoadScene(const SceneOptions& s) {
   Result<World> world = LoadWorld(s.scene, load);
   if (!world.ok()) return world.status().WithContext(s.scene);
   return world;
+}
+
+int CheckSceneIsRunWorld(const std::string& run_file, const World& world, bool any_world) {
+  const Status s = CheckRunWorld(run_file, world);
+  if (s.ok()) return kExitOk;
+  if (s.code() == StatusCode::kNotFound) {
+    Warn(s.message());
+    return kExitOk;
+  }
+  if (s.code() == StatusCode::kInvalidArgument && any_world) {
+    Warn(s.message() + "; scored anyway (--any-world)");
+    return kExitOk;
+  }
+  return Fail(s.code() == StatusCode::kInvalidArgument
+                  ? s.message() + "; --any-world scores it anyway"
+                  : s.message());
 }
 
 void AddDatasetInputOptions(CLI::App* sub, DatasetInput& in, bool with_start) {

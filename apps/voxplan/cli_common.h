@@ -95,6 +95,11 @@ struct SceneOptions {
 void AddSceneOptions(CLI::App* sub, SceneOptions* s, bool required);
 // Refuses a missing scene file or instance table, then loads the world; errors name the scene.
 Result<World> LoadScene(const SceneOptions& s);
+// eval run / eval objects: refuses (prints and returns kExitFailure) a --scene that is not the
+// world of the explore run that wrote run_file (explore/run_outputs.h CheckRunWorld); with
+// any_world (--any-world), or for a run that recorded no fingerprint, warns instead. kExitOk: go
+// on.
+int CheckSceneIsRunWorld(const std::string& run_file, const World& world, bool any_world);
 
 // The dataset a command reads and which of its frames: the positional folder, --format,
 // --min-depth, --max-depth, --frames, --stride (and --start where asked for).

@@ -36,6 +36,7 @@ struct EvalObjectsOptions {
   double max_attribution_m = 0.0;  // 0: no limit
   std::string exclude = "wall,floor,ceiling,door,window,structure";
   int threads = 0;
+  bool any_world = false;
 };
 
 int RunEvalObjects(const EvalObjectsOptions& o) {
@@ -47,6 +48,8 @@ int RunEvalObjects(const EvalObjectsOptions& o) {
   if (!reconstruction.ok()) return Fail(MessageNaming(reconstruction.status(), o.reconstruction));
   Result<World> world = LoadScene(o.scene);
   if (!world.ok()) return Fail(world.status().message());
+  if (int code = CheckSceneIsRunWorld(o.reconstruction, *world, o.any_world); code != kExitOk)
+    return code;
   if (world->instances.empty())
     return Fail(o.scene.scene + ": the world has no instances (no instance table beside it?)");
 
@@ -122,6 +125,9 @@ Command AddEvalObjectsCommand(CLI::App& eval) {
       "objects", "Per-object completeness and accuracy against a world with instances");
   objects->add_option("reconstruction", o->reconstruction, "Reconstructed mesh")->required();
   AddSceneOptions(objects, &o->scene, /*required=*/true);
+  objects->add_flag("--any-world", o->any_world,
+                    "Score against --scene even when it is not the world the run's metrics.json "
+                    "names");
   objects->add_option("--threshold", o->threshold_m, "Completeness distance threshold (m)")
       ->check(InRange(1e-4, 10.0, "m"))
       ->capture_default_str();

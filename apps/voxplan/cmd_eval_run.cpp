@@ -20,6 +20,7 @@ struct EvalRunOptions {
   SceneOptions scene;
   double resolution_m = 0.05;
   std::string csv;
+  bool any_world = false;
 };
 
 int RunEvalRun(const EvalRunOptions& o) {
@@ -38,6 +39,8 @@ int RunEvalRun(const EvalRunOptions& o) {
   if (!o.scene.scene.empty()) {
     Result<World> world = LoadScene(o.scene);
     if (!world.ok()) return Fail(world.status().message());
+    if (int code = CheckSceneIsRunWorld(o.run_log, *world, o.any_world); code != kExitOk)
+      return code;
     FloorPlanParams plan_params;
     plan_params.resolution_m = float(o.resolution_m);
     Result<FloorPlan> plan = RasterizeFloorPlan(*world, plan_params);
@@ -122,6 +125,8 @@ Command AddEvalRunCommand(CLI::App& eval) {
                           ->check(InRange(0.01, 1e6, "m²"));
   AddSceneOptions(run, &r->scene, /*required=*/false);
   run->get_option("--scene")->excludes(area);
+  run->add_flag("--any-world", r->any_world,
+                "Score against --scene even when it is not the world the run's metrics.json names");
   run->add_option("--resolution", r->resolution_m, "Floor plan cell size with --scene (m)")
       ->check(InRange(0.01, 1.0, "m"))
       ->capture_default_str();

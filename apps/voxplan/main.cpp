@@ -6,13 +6,14 @@
 #include <vector>
 
 #include "apps/voxplan/cli_common.h"
+#include "apps/voxplan/cli_examples.h"
 #include "apps/voxplan/signals.h"
 
 int main(int argc, char** argv) {
   using namespace voxplan::cli;
   CLI::App app{"voxplan: CPU voxel-hashing TSDF mapping (fuse RGB-D, mesh, evaluate, demo)",
                "voxplan"};
-  app.set_version_flag("--version", "voxplan 0.1.0");
+  app.set_version_flag("--version", "voxplan " VOXPLAN_VERSION);
   app.require_subcommand(1);
   // Usage errors read like every other error; CLI11's own help hint follows.
   app.failure_message([](const CLI::App* a, const CLI::Error& e) {
@@ -23,6 +24,7 @@ int main(int argc, char** argv) {
       AddFuseCommand(app),  AddMeshCommand(app), AddInfoCommand(app),
       AddEvalCommand(app),  AddDemoCommand(app), AddRenderCommand(app),
       AddBenchCommand(app), AddSimCommand(app),  AddExploreCommand(app)};
+  AddHelpExamples(app);
   try {
     app.parse(argc, argv);
   } catch (const CLI::CallForHelp& e) {

@@ -1,5 +1,6 @@
 // One exploration experiment through the library (explore/explore_run.h): a short greedy run on
-// a small apartment writes every artefact, and metrics.json agrees with the report and the logs;
+// a small apartment writes every artefact (the world it ran in among them, with a fingerprint
+// the evaluation commands check), and metrics.json agrees with the report and the logs;
 // a bad request is refused before the output folder exists, a failing run is not a refusal.
 #include <gtest/gtest.h>
 
@@ -13,6 +14,9 @@
 #include "explore/explore_run.h"
 #include "explore/robot_config.h"
 #include "explore/run_outputs.h"
+#include "sim/apartment.h"
+#include "sim/scene_loader.h"
+#include "sim/world_io.h"
 #include "tests/explore/explore_test_runs.h"
 #include "tests/support/test_support.h"
 
@@ -84,6 +88,24 @@ TEST(ExploreRun, ShortRunWritesEveryArtefactAndItsMetricsAgree) {
   EXPECT_GT(fs::file_size(dir / "out" / "mesh.ply"), 1000u);
   EXPECT_GT(fs::file_size(dir / "out" / "topdown.png"), 1000u);
   EXPECT_FALSE(fs::exists(dir / "out" / "planner.png"));  // only with keep_planner_drawings
+  // The world as run, read back as a scene: the fingerprint metrics.json records, which
+  // CheckRunWorld accepts for it and refuses for another seed's apartment.
+  for (const std::string& f : WorldFilePaths((dir / "out").string(), RunWorldFiles()))
+    EXPECT_TRUE(fs::is_regular_file(f)) << f;
+  Result<World> written = LoadWorld((dir / "out" / "world.ply").string());
+  ASSERT_TRUE(written.ok()) << written.status().message();
+  EXPECT_EQ(report->world_fingerprint, WorldFingerprintHex(*written));
+  EXPECT_TRUE(CheckRunWorld((dir / "out" / "run_log.csv").string(), *written).ok());
+  ApartmentParams other;
+  other.size = ApartmentSize::kS;
+  other.seed = 2;
+  Result<World> other_world = GenerateApartment(other);
+  ASSERT_TRUE(other_world.ok());
+  const Status refused_world = CheckRunWorld((dir / "out" / "mesh.ply").string(), *other_world);
+  EXPECT_EQ(refused_world.code(), StatusCode::kInvalidArgument);
+  EXPECT_NE(refused_world.message().find("not the world this run explored"), std::string::npos)
+      << refused_world.message();
+  EXPECT_TRUE(CheckRunWorld((dir / "no_run" / "mesh.ply").string(), *other_world).ok());
 
   // The report: a reconstructed surface, judged against the tour-observable ground truth.
   const ExploreResult& loop = report->loop;
@@ -112,6 +134,7 @@ TEST(ExploreRun, ShortRunWritesEveryArtefactAndItsMetricsAgree) {
     EXPECT_EQ(summary.erase(key), 1u) << key;
   EXPECT_EQ(summary, m);
   EXPECT_EQ(m["scene"], "apartment:size=S,seed=1");
+  EXPECT_EQ(m["world_fingerprint"], report->world_fingerprint);
   EXPECT_EQ(m["planner"], "greedy");
   EXPECT_EQ(m["robots"], 2);
   EXPECT_EQ(m["seed"], 5);

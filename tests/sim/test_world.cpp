@@ -8,6 +8,7 @@
 #include <map>
 #include <set>
 
+#include "sim/apartment.h"
 #include "sim/floor_plan.h"
 #include "sim/scene_loader.h"
 #include "sim/world_io.h"
@@ -328,6 +329,32 @@ TEST(FurnitureIndex, ReadsAndClassifies) {
             fs::absolute(test::SharedDataDir() / "objects/aws_furniture_index.tsv")
                 .lexically_normal()
                 .string());
+}
+
+TEST(WorldFingerprint, SurvivesWriteAndLoadAndTellsWorldsApart) {
+  test::TempDir dir("world_fingerprint");
+  ApartmentParams ap;
+  ap.size = ApartmentSize::kR;
+  ap.seed = 1;
+  Result<World> world = GenerateApartment(ap);
+  ASSERT_TRUE(world.ok()) << world.status().message();
+  WorldWriteOptions o;
+  o.write_glb = false;
+  ASSERT_TRUE(WriteWorld(*world, dir.path().string(), o).ok());
+  Result<World> back = LoadWorld((dir / "world.ply").string());
+  ASSERT_TRUE(back.ok()) << back.status().message();
+  EXPECT_EQ(WorldFingerprint(*back), WorldFingerprint(*world));  // the PLY shares vertices
+  EXPECT_EQ(WorldFingerprintHex(*world).size(), 16u);
+  ap.seed = 2;
+  Result<World> other = GenerateApartment(ap);
+  ASSERT_TRUE(other.ok());
+  EXPECT_NE(WorldFingerprint(*other), WorldFingerprint(*world));
+  World moved = *world;
+  for (Eigen::Vector3f& p : moved.mesh.positions) p.z() += 0.5f;
+  EXPECT_NE(WorldFingerprint(moved), WorldFingerprint(*world));
+  World relabelled = *world;
+  relabelled.triangle_instance[0] = kNoInstance;
+  EXPECT_NE(WorldFingerprint(relabelled), WorldFingerprint(*world));
 }
 
 }  // namespace

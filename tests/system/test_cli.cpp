@@ -49,6 +49,29 @@ TEST(CliTest, HelpAndUsageErrors) {
   EXPECT_EQ(kernel.exit_code, 2) << Describe(kernel);
 }
 
+TEST(CliTest, EveryCommandsHelpEndsWithExamplesAndVersionIsTheProjects) {
+  for (const std::string path :
+       {"fuse", "mesh", "info", "render", "eval mesh", "eval trajectory", "eval run",
+        "eval objects", "demo", "bench fusion", "bench raycast", "bench mesh", "bench maps",
+        "sim scene", "sim tour", "sim render", "explore"}) {
+    std::vector<std::string> args;
+    std::stringstream words(path);
+    for (std::string w; words >> w;) args.push_back(w);
+    args.push_back("--help");
+    const RunResult r = RunCli(args);
+    ASSERT_EQ(r.exit_code, 0) << Describe(r);
+    // Each example is a command of this path as typed.
+    EXPECT_NE(r.out.find("Examples:\n  voxplan " + path + " "), std::string::npos) << path << "\n"
+                                                                                   << r.out;
+  }
+  const RunResult explore = RunCli({"explore", "--help"});
+  EXPECT_NE(explore.out.find("Planners found:"), std::string::npos) << explore.out;
+  EXPECT_NE(explore.out.find(" greedy"), std::string::npos) << explore.out;
+  const RunResult version = RunCli({"--version"});
+  EXPECT_EQ(version.exit_code, 0);
+  EXPECT_EQ(version.out, "voxplan " VOXPLAN_TEST_VERSION "\n");
+}
+
 // One run covers fuse -> mesh -> info -> eval, so the 30-frame fusion is done only once.
 TEST(CliTest, FuseIclThenMeshInfoAndEval) {
   const test::TempDir dir("voxplan-cli-fuse");

@@ -85,6 +85,39 @@ TEST(ExploreCli, ShortRunWritesEveryOutputAndRepeatsItself) {
     EXPECT_EQ(ReadAll(dir / "a" / f), ReadAll(dir / "b" / f)) << f;
 }
 
+TEST(ExploreCli, EvalScoresTheRunAgainstItsOwnWorldAndRefusesAnother) {
+  test::TempDir dir("explore_cli_world");
+  std::vector<std::string> args = ShortRun(dir / "run");
+  const RunResult run = RunCli(args);
+  ASSERT_EQ(run.exit_code, 0) << Describe(run);
+  const std::string log = (dir / "run" / "run_log.csv").string();
+  const std::string mesh = (dir / "run" / "mesh.ply").string();
+  const std::string own = (dir / "run" / "world.ply").string();
+  const RunResult scored = RunCli({"eval", "run", log, "--scene", own});
+  EXPECT_EQ(scored.exit_code, 0) << Describe(scored);
+  const RunResult objects =
+      RunCli({"eval", "objects", mesh, "--scene", own, "--samples-per-m2", "200"});
+  EXPECT_EQ(objects.exit_code, 0) << Describe(objects);
+  // Another seed's apartment: refused with the reason, unless asked to score it anyway.
+  const RunResult other_world =
+      RunCli({"sim", "scene", "--generate", "apartment", "--size", "S", "--seed", "2", "--no-glb",
+              "--out", (dir / "other").string()});
+  ASSERT_EQ(other_world.exit_code, 0) << Describe(other_world);
+  const std::string other = (dir / "other" / "world.ply").string();
+  for (const std::vector<std::string>& cmd :
+       {std::vector<std::string>{"eval", "run", log, "--scene", other},
+        std::vector<std::string>{"eval", "objects", mesh, "--scene", other}}) {
+    const RunResult refused = RunCli(cmd);
+    EXPECT_EQ(refused.exit_code, 1) << Describe(refused);
+    EXPECT_NE(refused.err.find("not the world this run explored"), std::string::npos)
+        << refused.err;
+  }
+  const RunResult forced = RunCli({"eval", "run", log, "--scene", other, "--any-world"});
+  EXPECT_EQ(forced.exit_code, 0) << Describe(forced);
+  EXPECT_NE(forced.err.find("warning: the scene is not the world"), std::string::npos)
+      << forced.err;
+}
+
 TEST(ExploreCli, UnknownPlannerListsTheAvailableOnes) {
   test::TempDir dir("explore_cli_planner");
   const RunResult r = RunCli({"explore", "--scene", "apartment:size=S,seed=1", "--planner",
