@@ -12,10 +12,26 @@
 
 namespace voxplan {
 
+// A dollhouse view of an indoor mesh from outside: what hides the rooms cut away.
+struct DollhouseParams {
+  bool enabled = false;
+  Eigen::Vector3f up_W = Eigen::Vector3f::UnitZ();
+  float cut_fraction = 0.6f;  // a roofed mesh is cut this far up its extent along up_W
+};
+
+// The cutaway a dollhouse view of `mesh` takes (none unless enabled): back faces culled, so a
+// fused mesh's walls facing the camera and its ceilings (their normals face the rooms) vanish;
+// and for a mesh with a roof (upward-facing area within the top tenth of its extent along up_W,
+// at least a fifth of its footprint: a world's closed ceiling slabs) or with walls that face
+// outwards too (at least 30 % of the wall area facing away from the centre: closed boxes)
+// everything above cut_fraction of that extent.
+MeshCutaway DollhouseCutaway(const Mesh& mesh, const DollhouseParams& params);
+
 class MeshScene : public SurfaceScene {
  public:
   // Fails where Embree refuses the mesh.
-  static Result<std::unique_ptr<MeshScene>> Create(const Mesh& mesh);
+  static Result<std::unique_ptr<MeshScene>> Create(const Mesh& mesh,
+                                                   const MeshCutaway& cutaway = {});
   MeshScene(const Mesh& mesh, std::unique_ptr<MeshRaycaster> raycaster);
   // The box around the mesh's vertices.
   Eigen::AlignedBox3f Bounds() const override { return bounds_; }
@@ -28,9 +44,11 @@ class MeshScene : public SurfaceScene {
   Eigen::AlignedBox3f bounds_;
 };
 
-// A map (IsMapPath, io/map_io.h: a MapScene with `map_params`; one without blocks is refused) or a
-// mesh file (ReadMesh, then a MeshScene). Errors are the readers' and Embree's.
+// A map (IsMapPath, io/map_io.h: a MapScene with `map_params`; one without blocks is refused;
+// its rays always pass back faces, the map's dollhouse) or a mesh file (ReadMesh, then a MeshScene
+// with DollhouseCutaway). Errors are the readers' and Embree's.
 Result<std::unique_ptr<SurfaceScene>> LoadSurfaceScene(const std::string& path,
-                                                       const MapSceneParams& map_params);
+                                                       const MapSceneParams& map_params,
+                                                       const DollhouseParams& dollhouse = {});
 
 }  // namespace voxplan

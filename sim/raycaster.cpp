@@ -43,6 +43,15 @@ void OnEmbreeError(void* user_ptr, RTCError code, const char* message) {
 
 }  // namespace
 
+namespace {
+// What the cutaway filter reads: the raycaster's own copies, which outlive the Embree scene.
+struct CutawayView {
+  const std::vector<float>* vertices = nullptr;
+  const std::vector<uint32_t>* indices = nullptr;
+  const MeshCutaway* cutaway = nullptr;
+};
+}  // namespace
+
 struct MeshRaycaster::Impl {
   ErrorSink errors;
   RTCDevice device = nullptr;
@@ -52,6 +61,8 @@ struct MeshRaycaster::Impl {
   std::vector<uint32_t> indices;    // 3 per triangle
   std::vector<std::array<uint8_t, 3>> colors;  // empty or one per vertex
   std::vector<uint32_t> triangle_instance;     // empty or one per triangle
+  MeshCutaway cutaway;
+  CutawayView view;
 
   ~Impl() {
     if (scene) rtcReleaseScene(scene);
@@ -79,7 +90,44 @@ struct MeshRaycaster::Impl {
   }
 };
 
-Result<std::unique_ptr<MeshRaycaster>> MeshRaycaster::Create(const Mesh& mesh) {
+namespace {
+
+// Embree's intersection filter for a cutaway: rejects candidate hits on back faces (normal from
+// our counter-clockwise winding, not Embree's Ng convention) and beyond the cut height.
+void CutawayFilter(const RTCFilterFunctionNArguments* args) {
+  const auto* impl = static_cast<const CutawayView*>(args->geometryUserPtr);
+  for (unsigned i = 0; i < args->N; ++i) {
+    if (args->valid[i] != -1) continue;
+    const Eigen::Vector3f dir(RTCRayN_dir_x(args->ray, args->N, i),
+                              RTCRayN_dir_y(args->ray, args->N, i),
+                              RTCRayN_dir_z(args->ray, args->N, i));
+    if (impl->cutaway->cull_back_faces) {
+      const uint32_t* tri = &(*impl->indices)[size_t(RTCHitN_primID(args->hit, args->N, i)) * 3];
+      const auto vertex = [&](uint32_t v) {
+        return Eigen::Vector3f((*impl->vertices)[v * 3], (*impl->vertices)[v * 3 + 1],
+                               (*impl->vertices)[v * 3 + 2]);
+      };
+      const Eigen::Vector3f a = vertex(tri[0]);
+      if ((vertex(tri[1]) - a).cross(vertex(tri[2]) - a).dot(dir) >= 0.f) {
+        args->valid[i] = 0;
+        continue;
+      }
+    }
+    if (impl->cutaway->cut_above) {
+      const Eigen::Vector3f org(RTCRayN_org_x(args->ray, args->N, i),
+                                RTCRayN_org_y(args->ray, args->N, i),
+                                RTCRayN_org_z(args->ray, args->N, i));
+      // During filtering the ray's tfar holds the candidate hit's distance.
+      const Eigen::Vector3f p = org + RTCRayN_tfar(args->ray, args->N, i) * dir;
+      if (p.dot(impl->cutaway->up_W) > impl->cutaway->max_height_m) args->valid[i] = 0;
+    }
+  }
+}
+
+}  // namespace
+
+Result<std::unique_ptr<MeshRaycaster>> MeshRaycaster::Create(const Mesh& mesh,
+                                                             const MeshCutaway& cutaway) {
   const size_t nv = mesh.num_vertices();
   const size_t nt = mesh.num_triangles();
   if (!mesh.colors.empty() && mesh.colors.size() != nv)
@@ -111,6 +159,8 @@ Result<std::unique_ptr<MeshRaycaster>> MeshRaycaster::Create(const Mesh& mesh) {
   for (size_t t = 0; t < nt; ++t)
     for (int k = 0; k < 3; ++k) impl.indices[t * 3 + k] = mesh.triangles[t][k];
   impl.colors = mesh.colors;
+  impl.cutaway = cutaway;
+  impl.view = {&impl.vertices_xyz, &impl.indices, &impl.cutaway};
 
   impl.scene = rtcNewScene(impl.device);
   if (impl.scene) {
@@ -124,6 +174,10 @@ Result<std::unique_ptr<MeshRaycaster>> MeshRaycaster::Create(const Mesh& mesh) {
                                    impl.vertices_xyz.data(), 0, 3 * sizeof(float), nv);
         rtcSetSharedGeometryBuffer(geometry, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3,
                                    impl.indices.data(), 0, 3 * sizeof(uint32_t), nt);
+        if (cutaway.any()) {
+          rtcSetGeometryUserData(geometry, &impl.view);
+          rtcSetGeometryIntersectFilterFunction(geometry, CutawayFilter);
+        }
         rtcCommitGeometry(geometry);
         rtcAttachGeometryByID(impl.scene, geometry, 0);
         rtcReleaseGeometry(geometry);

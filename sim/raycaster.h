@@ -33,10 +33,24 @@ struct RenderOutput {
   Image<Eigen::Vector3f> normals_C;
 };
 
+// What a viewer may cut away (a dollhouse view of an indoor mesh; the sensors use neither): hits
+// on the back of a triangle (the ray along its outward normal: walls and ceilings of a room seen
+// from outside, as a fused mesh's normals face the free space it was seen from), and hits
+// farther than max_height_m along up_W.
+struct MeshCutaway {
+  bool cull_back_faces = false;
+  bool cut_above = false;
+  Eigen::Vector3f up_W = Eigen::Vector3f::UnitZ();  // unit
+  float max_height_m = 0.0f;                        // of p . up_W
+  bool any() const { return cull_back_faces || cut_above; }
+};
+
 class MeshRaycaster {
  public:
-  // Builds the Embree scene; Embree errors become a Status.
-  static Result<std::unique_ptr<MeshRaycaster>> Create(const Mesh& mesh);
+  // Builds the Embree scene; Embree errors become a Status. A cutaway makes Embree filter every
+  // candidate hit (slower): only viewers ask for one.
+  static Result<std::unique_ptr<MeshRaycaster>> Create(const Mesh& mesh,
+                                                       const MeshCutaway& cutaway = {});
   // As above, and labels pixels with the world's per-triangle instance ids; refuses a world
   // whose triangle_instance does not have one entry per triangle.
   static Result<std::unique_ptr<MeshRaycaster>> Create(const World& world);

@@ -29,6 +29,27 @@ Status RenderViewsParams::Validate() const {
   return Status::Ok();
 }
 
+namespace {
+
+// The mean share of pixels on a surface over an orbit's views, rendered at a tenth of the size.
+double PreviewHits(const SurfaceScene& scene, const RenderViewsParams& params,
+                   const OrbitFraming& framing) {
+  const PinholeCamera small = CameraFromFov(std::max(16, params.width / 10),
+                                            std::max(12, params.height / 10), params.fov_deg);
+  const std::vector<Pose3f> poses = OrbitPoses(framing.centre_W, framing.radius_m, framing.height_m,
+                                               std::max(params.orbit_views, 1), params.up_W);
+  double sum = 0.0;
+  for (const Pose3f& T_W_C : poses) {
+    const SurfaceImages s = scene.Render(small, T_W_C);
+    sum += double(std::count_if(s.depth.data.begin(), s.depth.data.end(),
+                                [](float z) { return z > 0.0f; })) /
+           double(std::max<size_t>(1, s.depth.data.size()));
+  }
+  return sum / double(poses.size());
+}
+
+}  // namespace
+
 Result<RenderedViews> RenderViews(const SurfaceScene& scene, const RenderViewsParams& params) {
   VOXPLAN_RETURN_IF_ERROR(params.Validate());
   RenderedViews views;
@@ -37,7 +58,17 @@ Result<RenderedViews> RenderViews(const SurfaceScene& scene, const RenderViewsPa
   OrbitFraming& framing = views.framing;
   framing = FrameBox(views.bounds_W, camera, params.orbit_elevation_deg);
   if (params.orbit_radius_m) framing.radius_m = *params.orbit_radius_m;
-  if (params.orbit_height_m) framing.height_m = *params.orbit_height_m;
+  if (params.orbit_height_m) {
+    framing.height_m = *params.orbit_height_m;
+  } else if (params.choose_side && !params.T_W_C) {
+    OrbitFraming below = framing;
+    below.height_m = -framing.height_m;
+    // Below only when it sees clearly more: from above is how rooms are drawn.
+    if (PreviewHits(scene, params, below) > 1.5 * PreviewHits(scene, params, framing)) {
+      framing = below;
+      views.from_below = true;
+    }
+  }
   framing.distance_m = std::hypot(framing.radius_m, framing.height_m);
   ShadeParams shade;
   if (params.T_W_C) {

@@ -27,6 +27,10 @@ struct RenderViewsParams {
   std::optional<float> orbit_radius_m;  // across the up axis; unset: framed on the bounds
   std::optional<float> orbit_height_m;  // along the up axis; unset: framed on the bounds
   float orbit_elevation_deg = 35.0f;    // of the framing
+  // An orbit framed on the bounds (no orbit height given) goes below the centre when a small
+  // preview of its views sees over 1.5 times the surface from there as from above: a room fused
+  // from inside shows its inside from the side its floor (or ceiling) faces.
+  bool choose_side = false;
 
   // Image size within core/bounds.h's, field of view in [1, 179] degrees, 0 to 3600 orbit
   // views, finite orbit numbers and pose; InvalidArgument naming the value otherwise.
@@ -41,6 +45,7 @@ struct RenderedViews {
   std::vector<Pose3f> T_W_C;  // one per image
   std::vector<ColorImage> images;
   double hit_fraction = 0.0;  // mean over the views of the share of pixels on a surface
+  bool from_below = false;    // choose_side put the orbit below the centre
 };
 
 // Renders and shades every view; fails when the params are invalid, when shading refuses an

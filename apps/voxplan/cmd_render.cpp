@@ -42,6 +42,7 @@ struct RenderOptions {
   double near_m = 0.0;          // maps: rays start this far out (cuts away near walls); 0: 0.01 m
   std::string kernel = "auto";  // maps: "scalar" marches the scalar reference (same images)
   int threads = 0;
+  std::string dollhouse = "auto";  // auto: on for orbits
 };
 
 Result<std::pair<int, int>> ParseSize(const std::string& text) {
@@ -99,7 +100,11 @@ int RunRender(const RenderOptions& o) {
   map_params.min_weight = float(o.min_weight);
   map_params.near_m = float(o.near_m);
   map_params.simd = o.kernel != "scalar";
-  Result<std::unique_ptr<SurfaceScene>> loaded = LoadSurfaceScene(o.input, map_params);
+  DollhouseParams dollhouse;
+  dollhouse.enabled = o.dollhouse == "on" || (o.dollhouse == "auto" && !params.T_W_C);
+  dollhouse.up_W = params.up_W;
+  params.choose_side = dollhouse.enabled;
+  Result<std::unique_ptr<SurfaceScene>> loaded = LoadSurfaceScene(o.input, map_params, dollhouse);
   if (!loaded.ok()) return Fail(MessageNaming(loaded.status(), o.input));
   const double load_ms = load_clock.ElapsedMs();
 
@@ -145,6 +150,7 @@ int RunRender(const RenderOptions& o) {
     j["orbit_height_m"] = RoundTo(views->framing.height_m, 6);
   }
   j["hit_fraction"] = RoundTo(views->hit_fraction, 6);
+  j["dollhouse"] = params.choose_side;
   j["threads"] = MaxThreads();
   j["load_ms"] = RoundTo(load_ms, 3);
   j["render_ms"] = RoundTo(render_ms, 3);
@@ -243,6 +249,12 @@ Command AddRenderCommand(CLI::App& app) {
       ->check(InRange(0.0, 1e4, "m"));
   sub->add_option("--kernel", o->kernel, "Maps: ray-casting march (scalar: the reference)")
       ->check(CLI::IsMember({"auto", "scalar"}))
+      ->capture_default_str();
+  sub->add_option("--dollhouse", o->dollhouse,
+                  "Cut away what hides the rooms (meshes: back faces, and a roof with all above "
+                  "60% of the height; maps pass back faces always) and orbit from the side that "
+                  "sees more; auto: for orbits")
+      ->check(CLI::IsMember({"auto", "on", "off"}))
       ->capture_default_str();
   sub->add_option("--threads", o->threads, "Worker threads (0: all hardware threads)")
       ->check(ThreadCount())

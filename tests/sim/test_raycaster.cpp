@@ -1,9 +1,11 @@
-// MeshRaycaster against analytic depth (box, plane), colour interpolation and determinism.
+// MeshRaycaster against analytic depth (box, plane), colour interpolation and determinism; the
+// viewer's cutaway (back faces, a cut height) and the dollhouse that chooses it.
 #include <gtest/gtest.h>
 
 #include <cmath>
 
 #include "core/parallel.h"
+#include "sim/mesh_scene.h"
 #include "sim/raycaster.h"
 #include "tests/support/test_support.h"
 
@@ -273,6 +275,61 @@ TEST(MeshRaycaster, RefusesWorldWithoutOneIdPerTriangle) {
   auto r = MeshRaycaster::Create(world);
   ASSERT_FALSE(r.ok());
   EXPECT_NE(r.status().message().find("two boxes"), std::string::npos) << r.status().message();
+}
+
+// A room as a fused mesh has it: a floor quad at z = 0 facing up and a ceiling quad at z = 2.5
+// facing down (both towards the room), 4 m square.
+Mesh FusedRoom() {
+  Mesh mesh;
+  mesh.positions = {{-2, -2, 0},    {2, -2, 0},    {2, 2, 0},    {-2, 2, 0},
+                    {-2, -2, 2.5f}, {2, -2, 2.5f}, {2, 2, 2.5f}, {-2, 2, 2.5f}};
+  mesh.triangles = {{0, 1, 2}, {0, 2, 3}, {4, 6, 5}, {4, 7, 6}};
+  return mesh;
+}
+
+TEST(MeshRaycaster, CutawayCullsBackFacesAndCutsAboveAHeight) {
+  const PinholeCamera camera = TestCamera(32, 24);
+  const Pose3f T_W_C = LookAt({0.1f, 0.2f, 6.f}, {0.f, 0.f, 0.f});  // from above, looking down
+  const float centre_depth = [&] {
+    auto plain = MeshRaycaster::Create(FusedRoom());
+    return (*plain)->Render(camera, T_W_C).depth.at(16, 12);
+  }();
+  EXPECT_NEAR(centre_depth, 3.5f, 0.05f);  // the ceiling's back, 6 - 2.5 m away
+  MeshCutaway cull;
+  cull.cull_back_faces = true;
+  auto culled = MeshRaycaster::Create(FusedRoom(), cull);
+  ASSERT_TRUE(culled.ok()) << culled.status().message();
+  EXPECT_NEAR((*culled)->Render(camera, T_W_C).depth.at(16, 12), 6.0f, 0.05f);  // the floor
+  // The ceiling turned to face up (a closed world's roof): culling keeps it, the cut removes it.
+  Mesh roofed = FusedRoom();
+  roofed.triangles[2] = {4, 5, 6};
+  roofed.triangles[3] = {4, 6, 7};
+  auto still_roofed = MeshRaycaster::Create(roofed, cull);
+  EXPECT_NEAR((*still_roofed)->Render(camera, T_W_C).depth.at(16, 12), 3.5f, 0.05f);
+  MeshCutaway cut = cull;
+  cut.cut_above = true;
+  cut.max_height_m = 1.5f;
+  auto opened = MeshRaycaster::Create(roofed, cut);
+  EXPECT_NEAR((*opened)->Render(camera, T_W_C).depth.at(16, 12), 6.0f, 0.05f);
+  // The sensors' raycaster (no cutaway) is unchanged: every image as before.
+  auto sensor = MeshRaycaster::Create(roofed);
+  EXPECT_EQ((*sensor)->Render(camera, T_W_C).depth.data,
+            (*MeshRaycaster::Create(roofed, MeshCutaway{}))->Render(camera, T_W_C).depth.data);
+}
+
+TEST(MeshScene, DollhouseCutsClosedRoomsAndOnlyCullsFusedOnes) {
+  DollhouseParams on;
+  on.enabled = true;
+  EXPECT_FALSE(DollhouseCutaway(FusedRoom(), DollhouseParams{}).any());
+  // Surfaces seen from inside (normals towards the room): culling is enough.
+  const MeshCutaway fused = DollhouseCutaway(FusedRoom(), on);
+  EXPECT_TRUE(fused.cull_back_faces);
+  EXPECT_FALSE(fused.cut_above);
+  // A closed box (a world's walls and roof face outwards): cut at 60 % of its height.
+  const MeshCutaway closed = DollhouseCutaway(BoxMesh({-2, -2, 0}, {2, 2, 2.5f}), on);
+  EXPECT_TRUE(closed.cull_back_faces);
+  EXPECT_TRUE(closed.cut_above);
+  EXPECT_NEAR(closed.max_height_m, 1.5f, 1e-5f);
 }
 
 }  // namespace

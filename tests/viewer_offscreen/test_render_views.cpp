@@ -107,5 +107,31 @@ TEST(ViewFilesTest, FailureRemovesTheFilesAndTheFoldersItMade) {
   EXPECT_TRUE(fs::is_empty(tmp.path()));
 }
 
+TEST(RenderViewsTest, ChoosingTheSideOrbitsBelowASurfaceSeenOnlyFromBelow) {
+  // A slab's underside: the SDF is positive below z = 0.5 and negative above, as a ceiling fused
+  // from the room under it.
+  const MapScene ceiling(
+      test::FillExactSdf([](const Eigen::Vector3f& p) { return 0.5f - p.z(); }, {0.02f, 0.08f},
+                         Eigen::Vector3f::Zero(), Eigen::Vector3f::Ones()),
+      MapSceneParams{});
+  RenderViewsParams params = SmallViews();
+  params.orbit_views = 3;
+  Result<RenderedViews> above = RenderViews(ceiling, params);
+  ASSERT_TRUE(above.ok()) << above.status().message();
+  EXPECT_FALSE(above->from_below);
+  EXPECT_GT(above->framing.height_m, 0.0f);
+  params.choose_side = true;
+  Result<RenderedViews> chosen = RenderViews(ceiling, params);
+  ASSERT_TRUE(chosen.ok()) << chosen.status().message();
+  EXPECT_TRUE(chosen->from_below);
+  EXPECT_LT(chosen->framing.height_m, 0.0f);
+  EXPECT_GT(chosen->hit_fraction, 2.0 * above->hit_fraction);
+  // A sphere looks the same from both sides: above, as without the choice.
+  const MapScene sphere = SphereScene();
+  Result<RenderedViews> round = RenderViews(sphere, params);
+  ASSERT_TRUE(round.ok());
+  EXPECT_FALSE(round->from_below);
+}
+
 }  // namespace
 }  // namespace voxplan
