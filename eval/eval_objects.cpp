@@ -68,7 +68,12 @@ Result<ObjectsEvalResult> EvaluateObjects(const Mesh& reconstruction, const Worl
   std::vector<Eigen::Vector3d> truth_points;
   std::vector<size_t> first_sample;                        // per evaluated object
   std::vector<int> object_of(world.instances.size(), -1);  // instance index -> object index
+  const size_t steps = world.instances.size() + 3;
+  const auto report = [&](size_t done) {
+    if (params.progress) params.progress(done, steps);
+  };
   for (size_t i = 0; i < world.instances.size(); ++i) {
+    report(i);
     const Instance& instance = world.instances[i];
     const auto& excluded = params.excluded_classes;
     if (std::find(excluded.begin(), excluded.end(), instance.class_name) != excluded.end())
@@ -111,6 +116,7 @@ Result<ObjectsEvalResult> EvaluateObjects(const Mesh& reconstruction, const Worl
     if (!recon_surface.ok()) return recon_surface.status();
     coverage = recon_surface->Distances(truth_points);
   }
+  report(world.instances.size() + 1);
   const double threshold = double(params.threshold_m);
   size_t covered_all = 0;
   for (size_t k = 0; k < result.objects.size(); ++k) {
@@ -134,11 +140,13 @@ Result<ObjectsEvalResult> EvaluateObjects(const Mesh& reconstruction, const Worl
       SampleSurface(reconstruction, params.samples_per_m2, ReconstructionSeed(params.seed), {}, 1,
                     "EvaluateObjects: reconstruction");
   if (!recon_samples.ok()) return recon_samples.status();
+  report(world.instances.size() + 2);
   Result<SurfaceDistance> world_surface =
       SurfaceDistance::Build(world.mesh, "EvaluateObjects: world mesh");
   if (!world_surface.ok()) return world_surface.status();
   std::vector<uint32_t> closest;
   const std::vector<double> accuracy = world_surface->Distances(recon_samples->points, &closest);
+  report(steps);
   result.reconstruction_samples = accuracy.size();
   std::vector<double> sum(result.objects.size(), 0.0), sum_sq(result.objects.size(), 0.0);
   for (size_t s = 0; s < accuracy.size(); ++s) {

@@ -10,6 +10,7 @@
 // than max_attribution_distance_m from any ground truth belong to no object.
 // Sampling and distances are those of EvaluateMesh (eval/eval_mesh.h).
 #include <cstdint>
+#include <functional>
 #include <limits>
 #include <string>
 #include <vector>
@@ -34,6 +35,9 @@ struct ObjectEvalParams {
   // Instances of these classes are scene structure, not objects: not evaluated.
   std::vector<std::string> excluded_classes = {"wall", "floor",  "ceiling",
                                                "door", "window", "structure"};
+  // Called with (steps done, steps in all): one step per instance sampled, then one each for the
+  // completeness distances, the reconstruction's samples and the accuracy distances. Optional.
+  std::function<void(size_t done, size_t total)> progress;
 };
 
 struct ObjectEvalResult {

@@ -3,6 +3,7 @@
 #include <filesystem>
 #include <iostream>
 #include <memory>
+#include <optional>
 #include <sstream>
 
 #include "apps/voxplan/cli_common.h"
@@ -61,7 +62,13 @@ int RunEvalObjects(const EvalObjectsOptions& o) {
   if (o.max_attribution_m > 0.0) params.max_attribution_distance_m = float(o.max_attribution_m);
   params.excluded_classes = SplitList(o.exclude);
   const Stopwatch clock;
+  std::optional<Progress> bar;
+  params.progress = [&bar](size_t done, size_t total) {
+    if (!bar) bar.emplace("eval objects", total, "steps");
+    bar->Update(done);
+  };
   Result<ObjectsEvalResult> result = EvaluateObjects(*reconstruction, *world, params);
+  if (bar) bar->Finish();
   if (!result.ok()) return Fail("evaluation failed: " + result.status().message());
   const ObjectsEvalResult& r = *result;
 

@@ -9,8 +9,11 @@
 
 namespace voxplan::cli {
 
-Progress::Progress(std::string label, size_t total)
-    : label_(std::move(label)), total_(total), tty_(::isatty(STDERR_FILENO) == 1) {}
+Progress::Progress(std::string label, size_t total, std::string unit)
+    : label_(std::move(label)),
+      total_(total),
+      unit_(std::move(unit)),
+      tty_(::isatty(STDERR_FILENO) == 1) {}
 
 void Progress::Update(size_t done) {
   if (total_ == 0) return;
@@ -30,7 +33,8 @@ void Progress::Update(size_t done) {
   const int decile = percent / 10;
   if (decile == last_decile_ || (decile == 0 && done < total_)) return;
   last_decile_ = decile;
-  std::fprintf(stderr, "%s: %zu/%zu frames (%d%%)\n", label_.c_str(), done, total_, percent);
+  std::fprintf(stderr, "%s: %zu/%zu %s (%d%%)\n", label_.c_str(), done, total_, unit_.c_str(),
+               percent);
 }
 
 void Progress::ClearBar() {

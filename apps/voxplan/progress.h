@@ -8,7 +8,8 @@ namespace voxplan::cli {
 
 class Progress {
  public:
-  Progress(std::string label, size_t total);
+  // unit names what is counted in the plain lines ("frames", "steps").
+  Progress(std::string label, size_t total, std::string unit = "frames");
   void Update(size_t done);
   // Prints a warning without tearing the bar.
   void Warn(const std::string& message);
@@ -18,6 +19,7 @@ class Progress {
   void ClearBar();
   std::string label_;
   size_t total_;
+  std::string unit_;
   bool tty_;
   bool bar_drawn_ = false;
   int last_decile_ = -1;

@@ -98,6 +98,7 @@ TEST(ExploreCli, EvalScoresTheRunAgainstItsOwnWorldAndRefusesAnother) {
   const RunResult objects =
       RunCli({"eval", "objects", mesh, "--scene", own, "--samples-per-m2", "200"});
   EXPECT_EQ(objects.exit_code, 0) << Describe(objects);
+  EXPECT_NE(objects.err.find("steps (100%)"), std::string::npos) << "no progress\n" << objects.err;
   // Another seed's apartment: refused with the reason, unless asked to score it anyway.
   const RunResult other_world =
       RunCli({"sim", "scene", "--generate", "apartment", "--size", "S", "--seed", "2", "--no-glb",
