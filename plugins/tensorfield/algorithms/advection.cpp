@@ -226,6 +226,10 @@ Pathline Advect(FieldAt field, const Eigen::Vector2d& start_m, double heading_ra
       break;
     }
     const double s_new = s + (*q - p).norm();
+    if (s_new - s < 1e-3 * h) {  // the wall push undid the step: the wall blocks the way
+      stop = AdvectionStop::kBlocked;
+      break;
+    }
     const TensorRaster& frame = field.Frame(s_new);
     const int cell = frame.geometry.IndexOf(*q);
     if (cell < 0 || (params.stop_outside_domain && !frame.InDomain(cell))) {

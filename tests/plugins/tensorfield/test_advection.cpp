@@ -99,6 +99,26 @@ TEST(Advection, VectorFieldKeepsItsSignAndRunsIntoASink) {
   EXPECT_LT(into.Length(), 1.05);
 }
 
+TEST(Advection, AWallPushThatUndoesTheStepEndsTheLineAsBlocked) {
+  // A vector field straight into a wall at x < 0.5, the push as long as the step: each step
+  // is pushed back to where it started. The line must end there (it once looped for ever).
+  omt::OccupancyRaster room = test::MakeRaster(4.0, 4.0, omt::Cell::kFree);
+  test::FillRect(&room, 0.0, 0.0, 0.5, 4.0, omt::Cell::kOccupied);
+  const omt::ClearanceRaster clearance = omt::ComputeClearance(room);
+  const TensorRaster into_wall = test::AnalyticField(
+      80, 80, [](const Eigen::Vector2d&) { return Eigen::Vector2d(-1.0, 0.0); });
+  AdvectionParams params;
+  params.vector_field = true;
+  params.max_length_m = 2.0;
+  params.wall_clearance_m = 0.3;
+  params.wall_push_per_step_m = params.step_m;
+  AdvectionObstacles obstacles;
+  obstacles.clearance = &clearance;
+  const Pathline line = AdvectPathline(into_wall, {0.725, 2.0}, kPi, {}, params, obstacles);
+  EXPECT_EQ(line.stop, AdvectionStop::kBlocked);
+  EXPECT_LT(line.Length(), 0.2);
+}
+
 TEST(Advection, CircularFieldIsFollowedAlongTheCircle) {
   const Eigen::Vector2d c(2.0, 2.0);
   // θ = polar angle + 90°: the major eigenvectors are tangent to circles around c.
