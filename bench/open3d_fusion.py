@@ -17,10 +17,19 @@ also ray cast (depth, normal, colour) at the poses of --raycast-poses (indexes i
 frames), each --raycast-rounds times, over the blocks in that frame's view frustum; the
 legacy volume has no ray caster.
 
+With --end-to-end MESH.ply the whole job is timed once instead, as `voxplan fuse --mesh` does
+it: every frame decoded and integrated (with colour), the mesh extracted and written (binary
+PLY). The JSON then gives job_s (from the first decode to the written mesh), its parts, and
+import_s (Python, NumPy and Open3D loading before it); bench/fuse_end_to_end.py runs it.
+
 Prints progress on stderr and one JSON object as the last stdout line. Run one path per
 process so each peak RSS (VmHWM) is its own. Set OMP_WAIT_POLICY=ACTIVE and
 OMP_NUM_THREADS (voxplan bench does), or Open3D's OpenMP loops stall on small machines.
 """
+import time
+
+_PROCESS_START = time.perf_counter()  # before the imports, which --end-to-end reports
+
 import argparse
 import json
 import math
@@ -28,7 +37,6 @@ import os
 import resource
 import statistics
 import sys
-import time
 
 SETUP_HINT = "install it with scripts/setup-deps --bench (Debian's python3-open3d)"
 
@@ -223,6 +231,66 @@ def run_vbg(m, args):
     return out
 
 
+def run_end_to_end(m, args):
+    """One whole job: decode, integrate with colour, extract the mesh, write it."""
+    import_s = time.perf_counter() - _PROCESS_START
+    frames = m["frames"]
+    t0 = time.perf_counter()
+    if args.path == "legacy":
+        intr = o3d.camera.PinholeCameraIntrinsic(m["width"], m["height"], m["fx"], m["fy"],
+                                                 m["cx"], m["cy"])
+        vol = o3d.pipelines.integration.ScalableTSDFVolume(
+            voxel_length=m["voxel_size_m"], sdf_trunc=m["trunc_m"],
+            color_type=o3d.pipelines.integration.TSDFVolumeColorType.RGB8)
+        for f in frames:
+            rgbd = o3d.geometry.RGBDImage.create_from_color_and_depth(
+                o3d.io.read_image(f["color"]), o3d.io.read_image(f["depth"]),
+                depth_scale=m["depth_scale"], depth_trunc=m["max_depth_m"],
+                convert_rgb_to_intensity=False)
+            vol.integrate(rgbd, intr,
+                          np.linalg.inv(np.array(f["T_W_C"], dtype=np.float64).reshape(4, 4)))
+        t1 = time.perf_counter()
+        mesh = vol.extract_triangle_mesh()
+        triangles = len(mesh.triangles)
+        t2 = time.perf_counter()
+        ok = o3d.io.write_triangle_mesh(args.end_to_end, mesh, write_ascii=False)
+    else:
+        dev = o3d.core.Device("CPU:0")
+        K = o3d.core.Tensor([[m["fx"], 0, m["cx"]], [0, m["fy"], m["cy"]], [0, 0, 1]],
+                            o3d.core.float64)
+        trunc_mult = m["trunc_m"] / m["voxel_size_m"]
+        vbg = o3d.t.geometry.VoxelBlockGrid(
+            attr_names=("tsdf", "weight", "color"),
+            attr_dtypes=(o3d.core.float32, o3d.core.float32, o3d.core.float32),
+            attr_channels=((1), (1), (3)), voxel_size=m["voxel_size_m"], block_resolution=8,
+            block_count=args.block_count or m.get("vbg_block_count", 200000), device=dev)
+        for f in frames:
+            depth = o3d.t.io.read_image(f["depth"])
+            color = o3d.t.io.read_image(f["color"])
+            extrinsic = o3d.core.Tensor(
+                np.linalg.inv(np.array(f["T_W_C"], dtype=np.float64).reshape(4, 4)),
+                o3d.core.float64)
+            coords = vbg.compute_unique_block_coordinates(
+                depth, K, extrinsic, m["depth_scale"], m["max_depth_m"],
+                trunc_voxel_multiplier=trunc_mult)
+            vbg.integrate(coords, depth, color, K, extrinsic, m["depth_scale"], m["max_depth_m"],
+                          trunc_voxel_multiplier=trunc_mult)
+        t1 = time.perf_counter()
+        mesh = vbg.extract_triangle_mesh(weight_threshold=0.5)
+        triangles = len(mesh.triangle.indices) if "indices" in mesh.triangle else 0
+        t2 = time.perf_counter()
+        ok = o3d.t.io.write_triangle_mesh(args.end_to_end, mesh, write_ascii=False)
+    t3 = time.perf_counter()
+    if not ok:
+        sys.exit("open3d_fusion.py: cannot write " + args.end_to_end)
+    log("%s end to end: %d frames, loop %.2f s, mesh %.2f s, write %.2f s (import %.2f s)"
+        % (args.path, len(frames), t1 - t0, t2 - t1, t3 - t2, import_s))
+    return {"end_to_end": True, "import_s": rounded(import_s), "job_s": rounded(t3 - t0),
+            "loop_s": rounded(t1 - t0), "mesh_s": rounded(t2 - t1), "write_s": rounded(t3 - t2),
+            "fps": rounded(len(frames) / (t1 - t0), 2), "triangles": triangles,
+            "mesh": args.end_to_end}
+
+
 def parse_indexes(text):
     try:
         return [int(x) for x in text.split(",") if x.strip()]
@@ -247,6 +315,8 @@ def main():
     parser.add_argument("--raycast-rounds", type=positive_int, default=3)
     parser.add_argument("--block-count", type=positive_int, default=0,
                         help="VBG capacity in blocks (default: the list's vbg_block_count)")
+    parser.add_argument("--end-to-end", metavar="MESH_PLY", default="",
+                        help="time one whole job instead: decode, integrate, mesh, write MESH_PLY")
     args = parser.parse_args()
 
     with open(args.frame_list) as f:
@@ -270,7 +340,10 @@ def main():
            "open3d_baseline_rss_mb": rounded(peak_rss_mb(), 1)}
     log("%s: %d frames, voxel %g m, %d repeats, OMP_NUM_THREADS=%s"
         % (args.path, len(frames), m["voxel_size_m"], args.repeat, out["omp_num_threads"]))
-    out.update(run_legacy(m, args) if args.path == "legacy" else run_vbg(m, args))
+    if args.end_to_end:
+        out.update(run_end_to_end(m, args))
+    else:
+        out.update(run_legacy(m, args) if args.path == "legacy" else run_vbg(m, args))
     out["open3d_%s_peak_rss_mb" % args.path] = rounded(peak_rss_mb(), 1)
     print(json.dumps(out))
 

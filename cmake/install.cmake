@@ -1,6 +1,7 @@
 # What `cmake --install` puts under the prefix (GNUInstallDirs), in two components that CPack
 # turns into two .debs:
-#   runtime (voxplan)      bin/voxplan, lib/voxplan/planners/libvoxplan_planner_*.so
+#   runtime (voxplan)      bin/voxplan, lib/voxplan/planners/libvoxplan_planner_*.so, the
+#                          Python package (lib/python3/dist-packages/voxplan under /usr)
 #   dev     (voxplan-dev)  lib/libvoxplan_*.a, include/voxplan/<folder>/*.h, the CMake package
 #                          (lib/cmake/voxplan: voxplan::<name> targets, voxplan_add_planner) and
 #                          the pkg-config files (lib/pkgconfig/voxplan*.pc)
@@ -69,6 +70,31 @@ if(TARGET voxplan)
   install(TARGETS voxplan RUNTIME DESTINATION ${CMAKE_INSTALL_BINDIR} COMPONENT runtime)
 endif()
 
+# The Python package (python/CMakeLists.txt calls these): where Debian's /usr/bin/python3 finds it
+# for the prefix. Under /usr that is lib/python3/dist-packages (Debian's own packages' folder);
+# under any other prefix lib/python3.<minor>/dist-packages, which for /usr/local is on that
+# interpreter's sys.path; for another prefix, PYTHONPATH=<prefix>/lib/python3.<minor>/dist-packages.
+# -DVOXPLAN_INSTALL_PYTHONDIR=<dir relative to the prefix> overrides it. In the runtime .deb.
+set(VOXPLAN_INSTALL_PYTHONDIR "" CACHE STRING
+  "Where the Python package goes, relative to the prefix (empty: chosen for Debian's python3)")
+function(voxplan_python_install_dir out major minor)
+  if(VOXPLAN_INSTALL_PYTHONDIR)
+    set(dir ${VOXPLAN_INSTALL_PYTHONDIR})
+  elseif(CMAKE_INSTALL_PREFIX STREQUAL "/usr")
+    set(dir lib/python${major}/dist-packages)
+  else()
+    set(dir lib/python${major}.${minor}/dist-packages)
+  endif()
+  set(${out} ${dir} PARENT_SCOPE)
+endfunction()
+# The extension module `target` and `files` (from `source_dir`) into <dir>/voxplan.
+function(voxplan_install_python target dir source_dir)
+  install(TARGETS ${target} LIBRARY DESTINATION ${dir}/voxplan COMPONENT runtime)
+  foreach(f ${ARGN})
+    install(FILES ${source_dir}/${f} DESTINATION ${dir}/voxplan COMPONENT runtime)
+  endforeach()
+endfunction()
+
 # The CMake package: find_dependency for every package the exported targets link (the
 # libraries are static, so their private dependencies too).
 configure_package_config_file(${CMAKE_CURRENT_LIST_DIR}/voxplanConfig.cmake.in
@@ -101,7 +127,8 @@ voxplan_pkg_config(voxplan-core "voxel blocks, hash map, TSDF volume, queries, r
 voxplan_pkg_config(voxplan-fusion "TSDF integration, tracking, marching cubes"
   REQUIRES voxplan-core LIBS ${pc_libdir} -lvoxplan_fusion -lopencv_imgproc -lopencv_core)
 voxplan_pkg_config(voxplan-io "dataset readers, trajectories, images, mesh and map files"
-  REQUIRES voxplan-core libpng libjpeg assimp LIBS ${pc_libdir} -lvoxplan_io)
+  REQUIRES voxplan-core libpng libjpeg zlib libdeflate assimp LIBS ${pc_libdir} -lvoxplan_io
+  -lrosbag_storage -lrostime -lroscpp_serialization -lcpp_common -lconsole_bridge)
 voxplan_pkg_config(voxplan-pipeline "whole fusion jobs over a dataset"
   REQUIRES voxplan-fusion voxplan-io LIBS ${pc_libdir} -lvoxplan_pipeline)
 set(umbrella voxplan-pipeline)
@@ -143,8 +170,8 @@ set(CPACK_DEBIAN_RUNTIME_PACKAGE_NAME voxplan)
 set(CPACK_DEBIAN_RUNTIME_PACKAGE_SHLIBDEPS ON)
 set(CPACK_DEBIAN_DEV_PACKAGE_NAME voxplan-dev)
 set(CPACK_DEBIAN_DEV_PACKAGE_SECTION libdevel)
-set(dev_depends libeigen3-dev libtbb-dev libpng-dev libjpeg62-turbo-dev libassimp-dev
-  nlohmann-json3-dev libopencv-imgproc-dev)
+set(dev_depends libeigen3-dev libtbb-dev libpng-dev libjpeg62-turbo-dev libdeflate-dev
+  libassimp-dev nlohmann-json3-dev libopencv-imgproc-dev librosbag-storage-dev)
 if(NOT VOXPLAN_ENGINE_ONLY)
   list(APPEND dev_depends liboctomap-dev libembree-dev)
   # Only the eval component needs CGAL.

@@ -11,6 +11,7 @@
 #include "core/parallel.h"
 #include "core/stopwatch.h"
 #include "fusion/integrate_kernel.h"
+#include "fusion/integrate_view.h"
 
 namespace voxplan {
 
@@ -205,7 +206,7 @@ class EndPairCache {
 };
 
 // The band of every valid pixel, or with `carve` everything from min depth through the band.
-std::vector<BlockIndex> CollectBlocks(const DepthImage& depth, const PinholeCamera& camera,
+std::vector<BlockIndex> CollectBlocks(ImageView<float> depth, const PinholeCamera& camera,
                                       const Pose3f& T_W_C, const IntegrateParams& params,
                                       const VolumeParams& volume_params, bool carve,
                                       size_t* valid_pixels = nullptr) {
@@ -359,16 +360,23 @@ void DropRefused(std::vector<BlockIndex>& band, std::vector<TsdfBlock*>& blocks)
 std::vector<BlockIndex> BlocksInTruncationBand(const DepthImage& depth, const PinholeCamera& camera,
                                                const Pose3f& T_W_C, const IntegrateParams& params,
                                                const VolumeParams& volume_params) {
-  return CollectBlocks(depth, camera, T_W_C, params, volume_params, false);
+  return CollectBlocks(ViewOf(depth), camera, T_W_C, params, volume_params, false);
 }
 
 std::vector<BlockIndex> BlocksToUpdate(const DepthImage& depth, const PinholeCamera& camera,
                                        const Pose3f& T_W_C, const IntegrateParams& params,
                                        const VolumeParams& volume_params) {
-  return CollectBlocks(depth, camera, T_W_C, params, volume_params, params.carve_free_space);
+  return CollectBlocks(ViewOf(depth), camera, T_W_C, params, volume_params,
+                       params.carve_free_space);
 }
 
 Result<IntegrateStats> IntegrateFrame(const DepthImage& depth, const ColorImage& color,
+                                      const PinholeCamera& camera, const Pose3f& T_W_C,
+                                      const IntegrateParams& params, TsdfVolume& volume) {
+  return IntegrateFrame(ViewOf(depth), ViewOf(color), camera, T_W_C, params, volume);
+}
+
+Result<IntegrateStats> IntegrateFrame(ImageView<float> depth, ImageView<uint32_t> color,
                                       const PinholeCamera& camera, const Pose3f& T_W_C,
                                       const IntegrateParams& params, TsdfVolume& volume) {
   VOXPLAN_RETURN_IF_ERROR(params.Validate());
@@ -381,6 +389,7 @@ Result<IntegrateStats> IntegrateFrame(const DepthImage& depth, const ColorImage&
                            std::to_string(camera.width) + "x" + std::to_string(camera.height));
   if (!color.empty() && (color.width != depth.width || color.height != depth.height))
     return InvalidArgument("colour image size differs from the depth image size");
+  if (depth.empty()) return InvalidArgument("depth image has no pixels");
   if (!T_W_C.matrix().allFinite()) return InvalidArgument("camera pose has NaN or infinite values");
 
   IntegrateStats stats;
@@ -410,8 +419,8 @@ Result<IntegrateStats> IntegrateFrame(const DepthImage& depth, const ColorImage&
 
   clock.Restart();
   internal::FrameView f;
-  f.depth = depth.data.data();
-  f.color = (params.integrate_color && !color.empty()) ? color.data.data() : nullptr;
+  f.depth = depth.data;
+  f.color = (params.integrate_color && !color.empty()) ? color.data : nullptr;
   f.width = depth.width;
   f.height = depth.height;
   f.fx = camera.fx;
@@ -451,8 +460,11 @@ Result<IntegrateStats> IntegrateFrame(const DepthImage& depth, const ColorImage&
   if (params.carve_free_space) {
     // Branch-free, so it vectorises.
     uint32_t valid = 0;
-    for (float d : depth.data)
+    const size_t n = size_t(depth.width) * size_t(depth.height);
+    for (size_t i = 0; i < n; ++i) {
+      const float d = depth.data[i];
       valid += uint32_t(d >= params.min_depth_m) & uint32_t(d <= params.max_depth_m);
+    }
     valid_pixels = valid;
   }
   stats.valid_pixels = valid_pixels;

@@ -200,7 +200,9 @@ std::vector<std::string> ListDataset::InputFiles() const {
   return files;
 }
 
-Result<std::unique_ptr<Dataset>> Finish(Draft d, const DatasetOptions& options) {
+}  // namespace
+
+Result<DatasetInfo> FinishInfo(Draft& d, const DatasetOptions& options) {
   if (d.entries.empty())
     return CorruptData(d.empty_message.empty() ? d.root + ": no frames found" : d.empty_message);
   DatasetInfo info;
@@ -208,6 +210,7 @@ Result<std::unique_ptr<Dataset>> Finish(Draft d, const DatasetOptions& options) 
   info.root = d.root;
   info.num_frames = d.entries.size();
   info.pose_source = d.pose_source;
+  info.frames_bad_pose = d.bad_poses;
   info.warnings = std::move(d.warnings);
   if (d.bad_poses > 0)
     info.warnings.push_back(
@@ -234,10 +237,19 @@ Result<std::unique_ptr<Dataset>> Finish(Draft d, const DatasetOptions& options) 
     if (!d.default_intrinsics_warning.empty())
       info.warnings.push_back(d.default_intrinsics_warning);
   }
-
-  // Every listed file must exist; colour is all or nothing.
   info.has_color = std::any_of(d.entries.begin(), d.entries.end(),
                                [](const Entry& e) { return !e.color_path.empty(); });
+  return info;
+}
+
+namespace {
+
+Result<std::unique_ptr<Dataset>> Finish(Draft d, const DatasetOptions& options) {
+  Result<DatasetInfo> finished = FinishInfo(d, options);
+  if (!finished.ok()) return finished.status();
+  DatasetInfo info = std::move(finished).value();
+
+  // Every listed file must exist; colour is all or nothing.
   std::error_code ec;
   for (const Entry& e : d.entries) {
     const std::string from = e.origin.empty() ? "" : " (listed at " + e.origin + ")";
@@ -270,9 +282,36 @@ Result<std::unique_ptr<Dataset>> Finish(Draft d, const DatasetOptions& options) 
 // ---------------------------------------------------------------------------------------------
 // Format detection, from the files present.
 
+// ROS 2 bags (SQLite .db3 or MCAP, in a folder with metadata.yaml) have no C++ reader in
+// Debian 12; the refusal says how to get a ROS 1 bag instead.
+bool IsRos2BagFile(const std::string& path) {
+  const std::string ext = LowerExtension(path);
+  return ext == ".db3" || ext == ".mcap";
+}
+
+Status RefuseRos2Bag(const std::string& what) {
+  return Unsupported(what +
+                     ": a ROS 2 bag, which voxplan cannot read (Debian 12 has no C++ reader for "
+                     "it); convert it to a ROS 1 .bag, e.g. `rosbags-convert --src <bag folder> "
+                     "--dst out.bag` (pip install rosbags) or with the ROS 2 bag tools, and pass "
+                     "the .bag");
+}
+
+// A folder `ros2 bag record` wrote: metadata.yaml naming rosbag2, or .db3 / .mcap files.
+bool IsRos2BagFolder(const fs::path& root) {
+  std::error_code ec;
+  for (fs::directory_iterator it(root, ec), end; !ec && it != end; it.increment(ec))
+    if (IsRos2BagFile(it->path().string())) return true;
+  const fs::path metadata = root / "metadata.yaml";
+  if (!fs::is_regular_file(metadata, ec)) return false;
+  Result<std::string> text = ReadFileToString(metadata.string());
+  return text.ok() && text->find("rosbag2_bagfile_information") != std::string::npos;
+}
+
 Result<DatasetFormat> DetectFormat(const fs::path& root) {
   std::error_code ec;
   const auto has = [&](const fs::path& p) { return fs::exists(p, ec); };
+  if (IsRos2BagFolder(root)) return RefuseRos2Bag(root.string());
   if (has(root / "associations.txt") &&
       (FindOne(root, ".gt.freiburg").ok() || !has(root / "depth.txt")))
     return DatasetFormat::kIclNuim;
@@ -288,10 +327,47 @@ Result<DatasetFormat> DetectFormat(const fs::path& root) {
     return has(root / "camera-intrinsics.txt") ? DatasetFormat::kThreeDMatch
                                                : DatasetFormat::kSevenScenes;
   if (fs::is_directory(root / "depth", ec)) return DatasetFormat::kRedwood;
+  if (FindOne(root, ".sens").ok()) return DatasetFormat::kScanNet;
+  if (FindOne(root, ".bag").ok()) return DatasetFormat::kRosBag;
   return Unsupported(root.string() +
                      ": cannot tell the dataset format (expected TUM depth.txt, ICL-NUIM "
                      "associations.txt + *.gt.freiburg, Redwood depth/, 7-Scenes/3DMatch "
-                     "frame-XXXXXX.depth.png, or Replica cam_params.json)");
+                     "frame-XXXXXX.depth.png, Replica cam_params.json, a ScanNet .sens file or a "
+                     "ROS .bag file)");
+}
+
+// The format of a dataset that is one file, from its extension.
+Result<DatasetFormat> DetectFileFormat(const fs::path& file) {
+  const std::string ext = LowerExtension(file.string());
+  if (ext == ".sens") return DatasetFormat::kScanNet;
+  if (ext == ".bag") return DatasetFormat::kRosBag;
+  if (IsRos2BagFile(file.string())) return RefuseRos2Bag(file.string());
+  return Unsupported(file.string() +
+                     ": not a dataset file (expected a dataset folder, a ScanNet "
+                     ".sens file or a ROS 1 .bag file)");
+}
+
+// The one `ext` file of a folder (ScanNet's scene0000_00/scene0000_00.sens, a folder with a bag).
+Result<fs::path> OneFileWithExtension(const fs::path& root, const std::string& ext) {
+  std::vector<std::string> found;
+  std::error_code ec;
+  for (fs::directory_iterator it(root, ec), end; !ec && it != end; it.increment(ec))
+    if (LowerExtension(it->path().string()) == ext) found.push_back(it->path().string());
+  if (ec) return IoError(root.string() + ": cannot list (" + ec.message() + ")");
+  if (found.empty()) return NotFound(root.string() + ": no " + ext + " file");
+  std::sort(found.begin(), found.end());
+  if (found.size() > 1)
+    return InvalidArgument(root.string() + ": holds " + std::to_string(found.size()) + " " + ext +
+                           " files (" + found[0] + ", " + found[1] +
+                           ", ...); name the one to read");
+  return fs::path(found.front());
+}
+
+// The readers of datasets that are one file.
+Result<std::unique_ptr<Dataset>> OpenFileDataset(const fs::path& file, DatasetFormat format,
+                                                 const DatasetOptions& options) {
+  if (format == DatasetFormat::kRosBag) return OpenRosBag(file, options);
+  return OpenScanNet(file, options);
 }
 
 }  // namespace
@@ -315,6 +391,10 @@ const char* DatasetFormatName(DatasetFormat f) {
       return "3dmatch";
     case DatasetFormat::kReplica:
       return "replica";
+    case DatasetFormat::kScanNet:
+      return "scannet";
+    case DatasetFormat::kRosBag:
+      return "rosbag";
   }
   return "unknown";
 }
@@ -334,11 +414,16 @@ Result<DatasetFormat> ParseDatasetFormat(const std::string& name) {
       {"7scenes", DatasetFormat::kSevenScenes},
       {"7-scenes", DatasetFormat::kSevenScenes},
       {"3dmatch", DatasetFormat::kThreeDMatch},
-      {"replica", DatasetFormat::kReplica}};
+      {"replica", DatasetFormat::kReplica},
+      {"scannet", DatasetFormat::kScanNet},
+      {"sens", DatasetFormat::kScanNet},
+      {"rosbag", DatasetFormat::kRosBag},
+      {"bag", DatasetFormat::kRosBag}};
   for (const auto& [key, format] : kNames)
     if (n == key) return format;
-  return InvalidArgument("unknown dataset format '" + name +
-                         "' (expected auto, tum, icl, redwood, 7scenes, 3dmatch or replica)");
+  return InvalidArgument(
+      "unknown dataset format '" + name +
+      "' (expected auto, tum, icl, redwood, 7scenes, 3dmatch, replica, scannet or rosbag)");
 }
 
 Result<std::unique_ptr<Dataset>> OpenDataset(const std::string& path,
@@ -346,19 +431,35 @@ Result<std::unique_ptr<Dataset>> OpenDataset(const std::string& path,
   using namespace dataset;  // fs, DetectFormat, the readers, Finish
   std::error_code ec;
   if (!fs::exists(path, ec)) return NotFound(path + ": dataset folder not found");
-  if (!fs::is_directory(path, ec)) return InvalidArgument(path + ": not a folder");
+  if (!(options.max_pose_gap_s > 0.0) || !std::isfinite(options.max_pose_gap_s))
+    return InvalidArgument("max pose gap must be positive and finite, got " +
+                           NumberText(options.max_pose_gap_s) + " s");
   // Trailing slashes would make parent_path() the folder itself.
   fs::path root = fs::path(path).lexically_normal();
   if (root.filename().empty()) root = root.parent_path();
 
-  if (!(options.max_pose_gap_s > 0.0) || !std::isfinite(options.max_pose_gap_s))
-    return InvalidArgument("max pose gap must be positive and finite, got " +
-                           NumberText(options.max_pose_gap_s) + " s");
+  if (!fs::is_directory(path, ec)) {
+    if (!fs::is_regular_file(path, ec))
+      return InvalidArgument(path + ": neither a folder nor a regular file");
+    auto detected = DetectFileFormat(root);
+    if (!detected.ok()) return detected.status();
+    if (options.format != DatasetFormat::kAuto && options.format != *detected)
+      return InvalidArgument(path + ": a " + DatasetFormatName(*detected) + " file, not " +
+                             DatasetFormatName(options.format) + " (that format is a folder)");
+    return OpenFileDataset(root, *detected, options);
+  }
+
   DatasetFormat format = options.format;
   if (format == DatasetFormat::kAuto) {
     auto detected = DetectFormat(root);
     if (!detected.ok()) return detected.status();
     format = *detected;
+  }
+  if (format == DatasetFormat::kScanNet || format == DatasetFormat::kRosBag) {
+    Result<fs::path> file =
+        OneFileWithExtension(root, format == DatasetFormat::kScanNet ? ".sens" : ".bag");
+    if (!file.ok()) return file.status();
+    return OpenFileDataset(*file, format, options);
   }
   Result<Draft> draft = Status(StatusCode::kInternal, "unreachable");
   switch (format) {
@@ -378,11 +479,18 @@ Result<std::unique_ptr<Dataset>> OpenDataset(const std::string& path,
     case DatasetFormat::kReplica:
       draft = ReadReplica(root);
       break;
+    case DatasetFormat::kScanNet:  // opened above
+    case DatasetFormat::kRosBag:
     case DatasetFormat::kAuto:
       break;
   }
   if (!draft.ok()) return draft.status();
   return Finish(std::move(draft).value(), options);
+}
+
+bool IsDatasetFile(const std::string& path) {
+  const std::string ext = LowerExtension(path);
+  return ext == ".sens" || ext == ".bag" || dataset::IsRos2BagFile(path);
 }
 
 }  // namespace voxplan

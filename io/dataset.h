@@ -1,7 +1,7 @@
 #pragma once
-// RGB-D dataset readers. The format is detected from the folder's files; intrinsics and depth
-// scale come from the dataset's own files unless overridden. Every error names the file (and
-// line) it came from.
+// RGB-D dataset readers. The format is detected from the folder's files (or, for the formats
+// that are one file, its extension); intrinsics and depth scale come from the dataset's own files
+// unless overridden. Every error names the file (and line, or frame) it came from.
 #include <memory>
 #include <optional>
 #include <string>
@@ -14,10 +14,33 @@
 
 namespace voxplan {
 
-enum class DatasetFormat { kAuto, kTum, kIclNuim, kRedwood, kSevenScenes, kThreeDMatch, kReplica };
+enum class DatasetFormat {
+  kAuto,
+  kTum,
+  kIclNuim,
+  kRedwood,
+  kSevenScenes,
+  kThreeDMatch,
+  kReplica,
+  kScanNet,  // one ScanNet .sens file (io/sens_file.h)
+  kRosBag,   // one ROS 1 .bag file (io/rosbag_file.h)
+};
 
 const char* DatasetFormatName(DatasetFormat f);  // "tum", "icl", "redwood", "7scenes", ...
 Result<DatasetFormat> ParseDatasetFormat(const std::string& name);
+
+// Which topics of a ROS bag to read; empty ones are found by their message types.
+struct RosBagTopics {
+  std::string depth;       // sensor_msgs/Image, 16UC1 / mono16 (mm) or 32FC1 (m)
+  std::string color;       // sensor_msgs/Image (rgb8, bgr8, rgba8, bgra8, mono8) or CompressedImage
+  std::string info;        // sensor_msgs/CameraInfo of the depth camera
+  std::string color_info;  // sensor_msgs/CameraInfo of the colour camera
+  std::string pose;        // geometry_msgs/PoseStamped, or /tf (tf2_msgs/TFMessage)
+  std::string frame;       // with TF: the camera frame (default: the depth images' frame_id)
+};
+// "depth=/camera/depth/image,color=/camera/rgb/image_color,info=...,pose=/tf" -> topics;
+// unknown keys, empty values and repeated keys are refused.
+Result<RosBagTopics> ParseRosBagTopics(const std::string& text);
 
 struct DatasetOptions {
   DatasetFormat format = DatasetFormat::kAuto;
@@ -26,6 +49,7 @@ struct DatasetOptions {
   // Timestamped ground truth (TUM): a frame is not interpolated between two poses further apart
   // than this (seconds); it gets no pose, PoseRejection::kGroundTruthGap.
   double max_pose_gap_s = 0.1;
+  RosBagTopics topics;  // ROS bags only
 };
 
 struct DatasetInfo {
@@ -37,7 +61,9 @@ struct DatasetInfo {
   bool has_color = false;
   std::string intrinsics_source;      // the file they came from, "flag" or "default (...)"
   std::string pose_source;            // the file poses came from, or "none"
+  size_t frames_bad_pose = 0;         // listed poses that are not rigid (-inf), kept without one
   std::vector<std::string> warnings;  // one line each, e.g. frames dropped for lack of poses
+  std::string streams;  // ROS bags: the topics read, "depth /camera/depth/image (32FC1), ..."
 };
 
 // Why a frame has no pose although its dataset lists one for it (or around it).
@@ -64,6 +90,7 @@ class Dataset {
   virtual ~Dataset() = default;
   virtual const DatasetInfo& info() const = 0;
   // Loads frame i (0 <= i < num_frames): decodes depth (and colour), checks sizes and bit depth.
+  // Called from several threads at once, for different frames (FuseDataset decodes ahead).
   virtual Result<Frame> Load(size_t i) const = 0;
   // Every file it reads: each frame's images, the pose and intrinsics files and the lists at
   // the top of its folder (every file there but meshes, maps and images), so that a command can
@@ -71,7 +98,15 @@ class Dataset {
   virtual std::vector<std::string> InputFiles() const { return {}; }
 };
 
+// `path` is a dataset folder, or a file holding a whole sequence (ScanNet .sens, ROS 1 .bag); a
+// folder holding exactly one such file (ScanNet's scene folders) reads that file. ROS 2 bags
+// (.db3, .mcap, or their folder) are refused with how to convert them to a ROS 1 bag.
 Result<std::unique_ptr<Dataset>> OpenDataset(const std::string& path,
                                              const DatasetOptions& options = {});
+
+// Whether `path` names a file OpenDataset takes as a dataset, by its extension (.sens, .bag; and
+// ROS 2's .db3 and .mcap, which it refuses saying how to convert them), so that a command taking
+// a dataset or another file can tell them apart.
+bool IsDatasetFile(const std::string& path);
 
 }  // namespace voxplan

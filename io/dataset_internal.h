@@ -3,8 +3,10 @@
 // OpenDataset finishes into a Dataset, the known cameras, the readers, and the parsing helpers
 // more than one reader uses. Internal to io/dataset*; io/dataset.h is the public face.
 #include <Eigen/Core>
+#include <Eigen/Geometry>
 #include <algorithm>
 #include <filesystem>
+#include <memory>
 #include <nlohmann/json_fwd.hpp>
 #include <optional>
 #include <string>
@@ -66,6 +68,38 @@ Result<Draft> ReadRedwood(const fs::path& root);                     // io/datas
 // 7-Scenes and 3DMatch; io/dataset_frame_folders.cpp.
 Result<Draft> ReadFrameFolders(const fs::path& root, DatasetFormat format);
 Result<Draft> ReadReplica(const fs::path& root);  // io/dataset_replica.cpp
+
+// Readers of formats that hold a whole sequence in one file decode their frames from it, so they
+// make their own Dataset (over FinishInfo) instead of a Draft of image files.
+Result<std::unique_ptr<Dataset>> OpenScanNet(const fs::path& sens_file,
+                                             const DatasetOptions& options);  // dataset_scannet.cpp
+Result<std::unique_ptr<Dataset>> OpenRosBag(const fs::path& bag_file,
+                                            const DatasetOptions& options);  // dataset_rosbag.cpp
+
+// What finishing shares across every reader (io/dataset.cpp): the options applied (depth scale,
+// intrinsics) and the warnings gathered, the bad poses counted. The image size is left to the
+// caller, which knows where it comes from.
+Result<DatasetInfo> FinishInfo(Draft& d, const DatasetOptions& options);
+
+// Timestamp association as TUM's tools do it (io/dataset_tum.cpp), shared with the ROS bag
+// reader. Images pair with the nearest image of the other stream within this (seconds, as in
+// TUM's associate.py).
+inline constexpr double kTumMaxAssociationDt = 0.02;
+// The index of the stamp in `sorted_t` nearest to t (the earlier one on a tie), if within
+// max_dt.
+std::optional<size_t> NearestStamp(const std::vector<double>& sorted_t, double t, double max_dt);
+struct StampedPose {
+  double t = 0.0;
+  Eigen::Vector3d translation;
+  Eigen::Quaterniond rotation;
+};
+Pose3d ToPose(const Eigen::Vector3d& t, const Eigen::Quaterniond& q);
+// Pose at time t between the two bracketing poses (sorted by t; lerp translation, slerp
+// rotation); none when t is outside the trajectory, or when the bracketing poses are more than
+// `max_gap` apart (then *gap_from / *gap_to are set: the motion across a gap is unknown,
+// interpolating it invents one).
+std::optional<Pose3d> InterpolatePose(const std::vector<StampedPose>& poses, double t,
+                                      double max_gap, double* gap_from, double* gap_to);
 
 // Helpers more than one reader uses, in io/dataset.cpp.
 // A pose read as a 4x4 matrix at `where` ("file:line"): a rigid one (ValidatePoseMatrix) becomes

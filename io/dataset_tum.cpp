@@ -16,11 +16,7 @@
 namespace voxplan::dataset {
 namespace {
 
-constexpr double kTumMaxAssociationDt = 0.02;  // seconds, as in TUM's associate.py
-
-// ---------------------------------------------------------------------------------------------
-// TUM RGB-D: rgb.txt, depth.txt, groundtruth.txt.
-
+// TUM's lists and ground truth.
 struct Stamped {
   double t = 0.0;
   std::string path;
@@ -43,12 +39,6 @@ Result<std::vector<Stamped>> ReadTumList(const std::string& path) {
   return out;
 }
 
-struct StampedPose {
-  double t = 0.0;
-  Eigen::Vector3d translation;
-  Eigen::Quaterniond rotation;
-};
-
 // Lines `t tx ty tz qx qy qz qw` (io/tum_trajectory.h); near-unit quaternions renormalised
 // with a warning.
 Result<std::vector<StampedPose>> ReadTumPoses(const std::string& path,
@@ -64,6 +54,11 @@ Result<std::vector<StampedPose>> ReadTumPoses(const std::string& path,
   return out;
 }
 
+}  // namespace
+
+// ---------------------------------------------------------------------------------------------
+// Association in time, shared with the ROS bag reader (io/dataset_internal.h).
+
 Pose3d ToPose(const Eigen::Vector3d& t, const Eigen::Quaterniond& q) {
   Pose3d pose = Pose3d::Identity();
   pose.linear() = q.normalized().toRotationMatrix();
@@ -71,9 +66,6 @@ Pose3d ToPose(const Eigen::Vector3d& t, const Eigen::Quaterniond& q) {
   return pose;
 }
 
-// Pose at time t between the two bracketing poses (lerp translation, slerp rotation); none when
-// t is outside the trajectory, or when the bracketing poses are more than `max_gap` apart (then
-// *gap_from / *gap_to are set: the motion across a gap is unknown, interpolating it invents one).
 std::optional<Pose3d> InterpolatePose(const std::vector<StampedPose>& poses, double t,
                                       double max_gap, double* gap_from, double* gap_to) {
   auto it = std::lower_bound(poses.begin(), poses.end(), t,
@@ -93,7 +85,18 @@ std::optional<Pose3d> InterpolatePose(const std::vector<StampedPose>& poses, dou
                 a.rotation.slerp(alpha, b.rotation));
 }
 
-}  // namespace
+std::optional<size_t> NearestStamp(const std::vector<double>& sorted_t, double t, double max_dt) {
+  auto it = std::lower_bound(sorted_t.begin(), sorted_t.end(), t);
+  std::optional<size_t> best;
+  if (it != sorted_t.end()) best = size_t(it - sorted_t.begin());
+  if (it != sorted_t.begin() && (!best || t - *(it - 1) <= sorted_t[*best] - t))
+    best = size_t(it - sorted_t.begin()) - 1;
+  if (!best || std::abs(sorted_t[*best] - t) > max_dt) return std::nullopt;
+  return best;
+}
+
+// ---------------------------------------------------------------------------------------------
+// TUM RGB-D: rgb.txt, depth.txt, groundtruth.txt.
 
 Result<Draft> ReadTum(const fs::path& root, double max_pose_gap_s) {
   Draft d;
@@ -157,6 +160,8 @@ Result<Draft> ReadTum(const fs::path& root, double max_pose_gap_s) {
     d.warnings.push_back(gt_txt + ": not found; frames have no pose");
   }
 
+  std::vector<double> rgb_t;
+  for (const Stamped& r : rgb) rgb_t.push_back(r.t);
   size_t no_rgb = 0, no_pose = 0, in_gap = 0;
   std::string first_gap;
   for (const Stamped& s : *depth) {
@@ -166,18 +171,14 @@ Result<Draft> ReadTum(const fs::path& root, double max_pose_gap_s) {
     e.timestamp = s.t;
     e.origin = where;
     if (have_rgb) {
-      auto it = std::lower_bound(rgb.begin(), rgb.end(), s.t,
-                                 [](const Stamped& r, double v) { return r.t < v; });
-      const Stamped* best = nullptr;
-      if (it != rgb.end()) best = &*it;
-      if (it != rgb.begin() && (!best || s.t - (it - 1)->t <= best->t - s.t)) best = &*(it - 1);
-      if (!best || std::abs(best->t - s.t) > kTumMaxAssociationDt) {
+      const std::optional<size_t> best = NearestStamp(rgb_t, s.t, kTumMaxAssociationDt);
+      if (!best) {
         ++no_rgb;
         d.warnings.push_back(where + ": no rgb frame within 0.02 s of depth " + NumberText(s.t) +
                              "; frame dropped");
         continue;
       }
-      e.color_path = (root / best->path).string();
+      e.color_path = (root / rgb[*best].path).string();
     }
     if (have_gt) {
       double gap_from = 0.0, gap_to = 0.0;

@@ -1,6 +1,7 @@
 #pragma once
 // PNG (libpng) and JPEG (libjpeg) decoding and PNG writing for depth and colour images. Every
 // error names the file; nothing is printed (libpng/libjpeg messages are captured into the Status).
+#include <cstddef>
 #include <cstdint>
 #include <string>
 
@@ -30,6 +31,14 @@ Result<DepthImage> ReadDepthPng(const std::string& path, double depth_scale);
 // bytes, not its extension. Truncated or corrupt files are refused (libjpeg's "premature end"
 // warning included).
 Result<ColorImage> ReadColorImage(const std::string& path);
+
+// The same for an image held in memory (a frame inside a container file); `name` is what errors
+// are named by ("scene.sens: frame 12").
+Result<ColorImage> DecodeColorImage(const void* data, size_t size, const std::string& name);
+
+// Encodes 8-bit RGB (the X byte dropped) as a baseline JPEG of `quality` (1..100), for files
+// that carry JPEG frames (ScanNet .sens) and their test fixtures.
+Result<std::string> EncodeJpeg(const ColorImage& color, int quality = 90);
 
 // Writes round(depth * depth_scale) as a 16-bit gray PNG. Invalid depth (<= 0, NaN, inf) is
 // written as 0; a finite depth that does not fit in 16 bits is refused rather than clipped, so a

@@ -3,9 +3,10 @@
 // demo and the tests share. Per selected frame: load, skip a frame without valid depth, choose
 // the pose (the dataset's, or with tracking the tracker's: the first frame starts from the
 // dataset pose, else the identity; a frame that loses tracking is not integrated), integrate,
-// record. A dataset pose fails PoseProblem (pipeline/frame_checks.h) or the reader rejected it:
-// skipped and counted; the first frames' depth is checked for a wrong depth scale. Counts and
-// timings come back in the report; progress and warnings go to the observer, never printed here.
+// record; the next frames are decoded meanwhile (FuseParams::prefetch). A dataset pose fails
+// PoseProblem (pipeline/frame_checks.h) or the reader rejected it: skipped and counted; the first
+// frames' depth is checked for a wrong depth scale. Counts and timings come back in the report;
+// progress and warnings go to the observer, never printed here.
 #include <cstddef>
 #include <functional>
 #include <string>
@@ -29,6 +30,13 @@ enum class OnMemoryLimit {
 struct FuseParams {
   IntegrateParams integrate;
   OnMemoryLimit on_memory_limit = OnMemoryLimit::kDrop;
+  // Frames decoded ahead, on worker tasks, while the caller's thread fuses the one before
+  // (Dataset::Load is then called from several threads at once, for different frames). Any
+  // value gives the same results: frames are fused in order on the calling thread, and the
+  // observer is called there. 0: load, then fuse, one frame after the other.
+  size_t prefetch = kDefaultPrefetch;
+  static constexpr size_t kDefaultPrefetch = 3;
+  static constexpr size_t kMaxPrefetch = 64;
   // Estimate poses by frame-to-model ICP instead of reading them from the dataset.
   bool track = false;
   TrackingParams tracking;
@@ -40,7 +48,12 @@ struct FuseParams {
   // counted, as are non-rigid ones and, always, ones whose view leaves the block index range).
   double max_pose_translation_m = 1e4;
 
-  Status Validate() const { return integrate.Validate(); }
+  Status Validate() const {
+    if (prefetch > kMaxPrefetch)
+      return InvalidArgument("prefetch must be at most " + std::to_string(kMaxPrefetch) +
+                             " frames, got " + std::to_string(prefetch));
+    return integrate.Validate();
+  }
 };
 
 struct FusedFrame {

@@ -5,6 +5,7 @@
 #include "core/stopwatch.h"
 #include "io/map_io.h"
 #include "io/mesh_io.h"
+#include "io/point_cloud_io.h"
 #include "io/tum_trajectory.h"
 
 namespace voxplan {
@@ -13,11 +14,16 @@ Result<FuseOutputs> WriteFuseOutputs(const FuseOutputPaths& paths, const TsdfVol
                                      const FuseReport& report, const MeshParams& mesh_params,
                                      const FrameListParams& list) {
   FuseOutputs out;
-  if (!paths.mesh.empty()) {
+  if (!paths.mesh.empty() || !paths.points.empty()) {
     const Stopwatch mesh_clock;
     out.mesh = ExtractMesh(volume, mesh_params);
     out.mesh_ms = mesh_clock.ElapsedMs();
+  }
+  if (!paths.mesh.empty()) {
     if (Status s = WriteMesh(out.mesh, paths.mesh); !s.ok()) return s.Naming(paths.mesh);
+  }
+  if (!paths.points.empty()) {
+    if (Status s = WritePointCloudPly(out.mesh, paths.points); !s.ok()) return s;
   }
   if (!paths.map.empty()) {
     if (Status s = SaveMap(volume, paths.map); !s.ok()) return s.Naming(paths.map);

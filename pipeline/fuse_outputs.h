@@ -1,7 +1,8 @@
 #pragma once
 // The files a fusion run writes beside its stats: the mesh (extracted here), the map, the
-// trajectory of the poses used and the frame list for reference pipelines. Each is written
-// through a temporary file and renamed; an empty path skips it.
+// trajectory of the poses used, the frame list for reference pipelines and the surface points
+// (the mesh's vertices: the TSDF's zero crossings, with colour and normals, as a PLY point
+// cloud). Each is written through a temporary file and renamed; an empty path skips it.
 #include <string>
 
 #include "core/mesh.h"
@@ -15,10 +16,11 @@ namespace voxplan {
 
 struct FuseOutputPaths {
   std::string mesh, map, trajectory, frame_list;
+  std::string points = {};  // initialised, so that four-path initialisers stay warning-free
 };
 
 struct FuseOutputs {
-  Mesh mesh;             // empty unless a mesh was asked for
+  Mesh mesh;             // empty unless a mesh or points were asked for
   double mesh_ms = 0.0;  // its extraction time
 };
 

@@ -93,10 +93,13 @@ int CheckSceneIsRunWorld(const std::string& run_file, const World& world, bool a
 }
 
 void AddDatasetInputOptions(CLI::App* sub, DatasetInput& in, bool with_start) {
-  sub->add_option("dataset", in.dataset, "Dataset folder")->required();
+  sub->add_option("dataset", in.dataset, "Dataset folder (or ScanNet .sens, ROS .bag file)")
+      ->required();
   sub->add_option("--format", in.format, "Dataset format")
-      ->check(CLI::IsMember({"auto", "tum", "icl", "redwood", "7scenes", "3dmatch", "replica"}))
+      ->check(CLI::IsMember(
+          {"auto", "tum", "icl", "redwood", "7scenes", "3dmatch", "replica", "scannet", "rosbag"}))
       ->capture_default_str();
+  AddTopicsOption(sub, in.topics);
   sub->add_option("--min-depth", in.min_depth_m, "Ignore depth below this (m)")
       ->check(InRange(0.0, bounds::kDepthMaxM, "m"))
       ->capture_default_str();
@@ -116,6 +119,12 @@ void AddDatasetInputOptions(CLI::App* sub, DatasetInput& in, bool with_start) {
       ->capture_default_str();
 }
 
+void AddTopicsOption(CLI::App* sub, std::string& topics) {
+  sub->add_option("--topics", topics,
+                  "ROS bags: topics to read instead of those found by type, "
+                  "depth=T,color=T,info=T,color_info=T,pose=T (PoseStamped or /tf),frame=F");
+}
+
 int OpenDatasetInput(const DatasetInput& in, DatasetOptions options, OpenedDataset* out) {
   if (in.max_depth_m <= in.min_depth_m) {
     return Fail("--max-depth must be greater than --min-depth", kExitUsage);
@@ -123,12 +132,17 @@ int OpenDatasetInput(const DatasetInput& in, DatasetOptions options, OpenedDatas
   Result<DatasetFormat> format = ParseDatasetFormat(in.format);
   if (!format.ok()) return Fail(format.status().message(), kExitUsage);
   options.format = *format;
+  if (!in.topics.empty()) {
+    Result<RosBagTopics> topics = ParseRosBagTopics(in.topics);
+    if (!topics.ok()) return Fail(topics.status().message(), kExitUsage);
+    options.topics = *topics;
+  }
   std::error_code ec;
   if (!std::filesystem::exists(in.dataset, ec)) {
     return Fail("dataset folder not found: " + in.dataset);
   }
-  if (!std::filesystem::is_directory(in.dataset, ec)) {
-    return Fail("dataset is not a folder: " + in.dataset);
+  if (!std::filesystem::is_directory(in.dataset, ec) && !IsDatasetFile(in.dataset)) {
+    return Fail("dataset is not a folder (nor a .sens or .bag file): " + in.dataset);
   }
   Result<std::unique_ptr<Dataset>> opened = OpenDataset(in.dataset, options);
   if (!opened.ok()) return Fail(MessageNaming(opened.status(), in.dataset));
@@ -189,6 +203,16 @@ std::string CheckOutputFile(const std::string& path) {
 
 CLI::Validator OutputFileValidator() {
   return CLI::Validator([](std::string& path) { return CheckOutputFile(path); }, "FILE");
+}
+
+CLI::Validator OutputWithExtensionValidator(const std::string& extension, const std::string& what) {
+  return CLI::Validator(
+      [extension, what](std::string& path) -> std::string {
+        if (LowerExtension(path) != extension)
+          return what + " must be a " + extension + " file: " + path;
+        return CheckOutputFile(path);
+      },
+      "FILE");
 }
 
 CLI::Validator MeshOutputValidator() {

@@ -68,6 +68,8 @@ std::string CheckOutputFile(const std::string& path);
 // CLI11 validators built on CheckOutputFile; the mesh one also checks the extension.
 CLI::Validator OutputFileValidator();
 CLI::Validator MeshOutputValidator();
+// An output whose extension must be `extension` (".ply", ".bt"), `what` naming it in the error.
+CLI::Validator OutputWithExtensionValidator(const std::string& extension, const std::string& what);
 // Numeric checks with short messages (CLI11 2.1's own print the whole double range).
 CLI::Validator Positive();
 CLI::Validator NonNegative();
@@ -111,8 +113,11 @@ struct DatasetInput {
   int64_t frames = 0;  // 0: all; signed so CLI11 refuses negative values instead of wrapping
   int64_t start = 0;
   int64_t stride = 1;
+  std::string topics;  // ROS bags: "depth=...,color=...,info=...,pose=..."
 };
 void AddDatasetInputOptions(CLI::App* sub, DatasetInput& in, bool with_start = false);
+// --topics of the commands that read datasets (ROS bags' topics, io/dataset.h RosBagTopics).
+void AddTopicsOption(CLI::App* sub, std::string& topics);
 
 struct OpenedDataset {
   std::unique_ptr<Dataset> dataset;

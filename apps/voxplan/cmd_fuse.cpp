@@ -19,6 +19,7 @@
 #include "io/frame_list.h"
 #include "pipeline/fuse_dataset.h"
 #include "pipeline/fuse_outputs.h"
+#include "planning/octomap_export.h"
 
 namespace voxplan::cli {
 
@@ -41,10 +42,12 @@ struct FuseOptions {
   double max_weight = 64.0;
   double mesh_min_weight = 0.5;
   std::string mesh_path, map_path, stats_path, frame_list_path, trajectory_path;
+  std::string points_path, octomap_path;
   bool track = false;
   double photometric_weight = 0.0;
   MemoryBudgetOptions memory;
   double max_pose_gap_s = 0.1;
+  size_t prefetch = FuseParams::kDefaultPrefetch;
 };
 
 nlohmann::json OrNull(const std::string& path) {
@@ -54,7 +57,8 @@ nlohmann::json OrNull(const std::string& path) {
 // The stats object: the same on the last stdout line and in --stats.
 nlohmann::json FuseStats(const FuseOptions& o, const DatasetInfo& info,
                          const IntegrateParams& params, const FuseReport& report,
-                         const TsdfVolume& volume, const Mesh& mesh, double mesh_ms) {
+                         const TsdfVolume& volume, const Mesh& mesh, double mesh_ms,
+                         const std::optional<OctomapExportStats>& octomap) {
   const TimingSummary load_t = Summarize(report.load_ms),
                       integrate_t = Summarize(report.integrate_ms),
                       frame_t = Summarize(report.frame_ms);
@@ -104,6 +108,11 @@ nlohmann::json FuseStats(const FuseOptions& o, const DatasetInfo& info,
   AddMapStats(j, volume);
   AddMeshStats(j, mesh, mesh_ms);
   j["mesh"] = OrNull(o.mesh_path);
+  j["points"] = OrNull(o.points_path);
+  j["point_count"] = o.points_path.empty() ? 0 : mesh.num_vertices();
+  j["octomap"] = OrNull(o.octomap_path);
+  j["octomap_occupied_voxels"] = octomap ? octomap->occupied_voxels : 0;
+  j["octomap_free_voxels"] = octomap ? octomap->free_voxels : 0;
   j["map"] = OrNull(o.map_path);
   j["stats"] = OrNull(o.stats_path);
   j["peak_rss_mb"] = PeakRssMb();
@@ -122,7 +131,9 @@ int RefuseCollisions(const FuseOptions& o, const Dataset& dataset) {
                                {"--map", o.map_path},
                                {"--stats", o.stats_path},
                                {"--trajectory", o.trajectory_path},
-                               {"--frame-list", o.frame_list_path}},
+                               {"--frame-list", o.frame_list_path},
+                               {"--points", o.points_path},
+                               {"--octomap", o.octomap_path}},
                               inputs);
 }
 
@@ -165,6 +176,7 @@ int RunFuse(const FuseOptions& o) {
   FuseParams fuse;
   fuse.integrate = params;
   fuse.track = o.track;
+  fuse.prefetch = o.prefetch;
   fuse.on_memory_limit = MemoryLimitAction(o.memory);
   fuse.tracking.photometric_weight = float(o.photometric_weight);
   fuse.tracking.raycast.max_depth_m = float(o.in.max_depth_m);
@@ -191,12 +203,20 @@ int RunFuse(const FuseOptions& o) {
   const FrameListParams list{info.camera, info.depth_scale, o.voxel_size_m,
                              o.trunc_m,   o.in.min_depth_m, o.in.max_depth_m};
   OutputTransaction written;  // every output lands, or none
-  Result<FuseOutputs> outputs =
-      WriteFuseOutputs({o.mesh_path, o.map_path, o.trajectory_path, o.frame_list_path}, volume,
-                       report, mesh_params, list);
+  Result<FuseOutputs> outputs = WriteFuseOutputs(
+      {o.mesh_path, o.map_path, o.trajectory_path, o.frame_list_path, o.points_path}, volume,
+      report, mesh_params, list);
   if (!outputs.ok()) return Fail(outputs.status().message());
   const Mesh& mesh = outputs->mesh;
-  const nlohmann::json j = FuseStats(o, info, params, report, volume, mesh, outputs->mesh_ms);
+  // The occupancy as an OctoMap tree (planning/octomap_export.h), staged with the rest.
+  std::optional<OctomapExportStats> octomap;
+  if (!o.octomap_path.empty()) {
+    Result<OctomapExportStats> exported = ExportOctomap(volume, o.octomap_path);
+    if (!exported.ok()) return Fail(MessageNaming(exported.status(), o.octomap_path));
+    octomap = *exported;
+  }
+  const nlohmann::json j =
+      FuseStats(o, info, params, report, volume, mesh, outputs->mesh_ms, octomap);
   const size_t integrated = report.frames.size();
   if (!o.stats_path.empty()) {
     if (Status s = WriteJsonFile(j, o.stats_path); !s.ok()) {
@@ -219,6 +239,12 @@ int RunFuse(const FuseOptions& o) {
               << mesh.num_triangles() << " triangles, " << j["mesh_ms"] << " ms)\n";
   }
   if (!o.map_path.empty()) std::cerr << "map file: " << o.map_path << "\n";
+  if (!o.points_path.empty())
+    std::cerr << "points: " << o.points_path << " (" << mesh.num_vertices() << " points)\n";
+  if (octomap) {
+    std::cerr << "octomap: " << o.octomap_path << " (" << octomap->occupied_voxels << " occupied, "
+              << octomap->free_voxels << " free voxels)\n";
+  }
   if (!o.stats_path.empty()) std::cerr << "stats: " << o.stats_path << "\n";
   PrintJsonLine(j);
   return kExitOk;
@@ -258,6 +284,13 @@ Command AddFuseCommand(CLI::App& app) {
   sub->add_option("--mesh", o->mesh_path, "Write the mesh (.ply .obj .glb .stl)")
       ->check(MeshOutputValidator());
   sub->add_option("--map", o->map_path, "Write the map (.vpmap)")->check(OutputFileValidator());
+  sub->add_option("--points", o->points_path,
+                  "Write the surface as a point cloud (.ply: the mesh's vertices, with colour and "
+                  "normals)")
+      ->check(OutputWithExtensionValidator(".ply", "--points"));
+  sub->add_option("--octomap", o->octomap_path,
+                  "Write the occupancy as an OctoMap binary tree (.bt; occupied and free voxels)")
+      ->check(OutputWithExtensionValidator(".bt", "--octomap"));
   sub->add_option("--stats", o->stats_path, "Write the stats JSON")->check(OutputFileValidator());
   sub->add_flag("--track", o->track,
                 "Estimate poses by frame-to-model ICP instead of using the dataset's");
@@ -276,6 +309,10 @@ Command AddFuseCommand(CLI::App& app) {
   sub->add_option("--frame-list", o->frame_list_path,
                   "Write the integrated frames (paths, poses, intrinsics) as JSON")
       ->check(OutputFileValidator());
+  sub->add_option("--prefetch", o->prefetch,
+                  "Frames decoded ahead while one is fused (0: one after the other; same results)")
+      ->check(CLI::Range(size_t(0), FuseParams::kMaxPrefetch))
+      ->capture_default_str();
   AddMemoryBudgetOptions(sub, o->memory);
   return {sub, [o] { return RunFuse(*o); }};
 }

@@ -18,6 +18,7 @@ namespace fs = std::filesystem;
 struct InfoOptions {
   std::string path;
   std::string format = "auto";
+  std::string topics;
 };
 
 int DatasetInfoCommand(const InfoOptions& o) {
@@ -25,6 +26,11 @@ int DatasetInfoCommand(const InfoOptions& o) {
   Result<DatasetFormat> format = ParseDatasetFormat(o.format);
   if (!format.ok()) return Fail(format.status().message(), kExitUsage);
   options.format = *format;
+  if (!o.topics.empty()) {
+    Result<RosBagTopics> topics = ParseRosBagTopics(o.topics);
+    if (!topics.ok()) return Fail(topics.status().message(), kExitUsage);
+    options.topics = *topics;
+  }
   Result<std::unique_ptr<Dataset>> dataset = OpenDataset(o.path, options);
   if (!dataset.ok()) return Fail(MessageNaming(dataset.status(), o.path));
   const DatasetInfo& info = (*dataset)->info();
@@ -38,7 +44,11 @@ int DatasetInfoCommand(const InfoOptions& o) {
               info.intrinsics_source.c_str());
   std::printf("depth scale %g units per metre\n", info.depth_scale);
   std::printf("poses       %s\n", info.pose_source.c_str());
+  if (info.frames_bad_pose > 0)
+    std::printf("bad poses   %zu of %zu frames (not rigid, e.g. ScanNet's -inf: no pose)\n",
+                info.frames_bad_pose, info.num_frames);
   std::printf("colour      %s\n", info.has_color ? "yes" : "no");
+  if (!info.streams.empty()) std::printf("topics      %s\n", info.streams.c_str());
   std::printf("warnings    %zu\n", info.warnings.size());
   for (const std::string& w : info.warnings) std::printf("  %s\n", w.c_str());
   std::fflush(stdout);
@@ -54,7 +64,9 @@ int DatasetInfoCommand(const InfoOptions& o) {
   j["intrinsics_source"] = info.intrinsics_source;
   j["depth_scale"] = info.depth_scale;
   j["pose_source"] = info.pose_source;
+  j["frames_bad_pose"] = info.frames_bad_pose;
   j["has_color"] = info.has_color;
+  if (!info.streams.empty()) j["topics"] = info.streams;
   j["warnings"] = info.warnings;
   PrintJsonLine(j);
   return kExitOk;
@@ -105,8 +117,9 @@ int MapInfoCommand(const InfoOptions& o) {
 int RunInfo(const InfoOptions& o) {
   std::error_code ec;
   if (fs::is_directory(o.path, ec)) return DatasetInfoCommand(o);
+  if (fs::is_regular_file(o.path, ec) && IsDatasetFile(o.path)) return DatasetInfoCommand(o);
   if (fs::is_regular_file(o.path, ec)) return MapInfoCommand(o);
-  return Fail("not found (want a dataset folder or a .vpmap file): " + o.path);
+  return Fail("not found (want a dataset folder or file, or a .vpmap file): " + o.path);
 }
 
 }  // namespace
@@ -114,10 +127,13 @@ int RunInfo(const InfoOptions& o) {
 Command AddInfoCommand(CLI::App& app) {
   auto o = std::make_shared<InfoOptions>();
   CLI::App* sub = app.add_subcommand("info", "Describe a dataset folder or a map file");
-  sub->add_option("path", o->path, "Dataset folder or .vpmap file")->required();
-  sub->add_option("--format", o->format, "Dataset format (folders only)")
-      ->check(CLI::IsMember({"auto", "tum", "icl", "redwood", "7scenes", "3dmatch", "replica"}))
+  sub->add_option("path", o->path, "Dataset folder or file (.sens, .bag), or .vpmap file")
+      ->required();
+  sub->add_option("--format", o->format, "Dataset format (datasets only)")
+      ->check(CLI::IsMember(
+          {"auto", "tum", "icl", "redwood", "7scenes", "3dmatch", "replica", "scannet", "rosbag"}))
       ->capture_default_str();
+  AddTopicsOption(sub, o->topics);
   return {sub, [o] { return RunInfo(*o); }};
 }
 

@@ -29,6 +29,7 @@ class FusionBench {
         p_(params),
         progress_(progress) {
     fuse_params_.integrate = p_.integrate;
+    fuse_params_.prefetch = 0;  // decoding timed apart from integration, never beside it
   }
 
   Result<FusionBenchResult> Run();

@@ -1,9 +1,11 @@
-// WriteFuseOutputs round trips: what it writes reads back as the run's mesh, map, poses and
-// frames; empty paths write nothing; a failed write names its file.
+// WriteFuseOutputs round trips: what it writes reads back as the run's mesh, map, poses, frames
+// and surface points; empty paths write nothing; a failed write names its file.
 #include <gtest/gtest.h>
 
+#include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <iterator>
 #include <nlohmann/json.hpp>
 
 #include "io/map_io.h"
@@ -63,6 +65,34 @@ TEST(FuseOutputs, WhatIsWrittenReadsBackAsTheRun) {
   ASSERT_EQ(frames["frames"].size(), 2u);
   EXPECT_EQ(frames["frames"][1]["depth"], "d1.png");
   EXPECT_EQ(frames["width"], list.camera.width);
+}
+
+// The surface points are the mesh's vertices: on the sphere, with its colour and unit normals.
+TEST(FuseOutputs, PointsAreTheSurfaceAsAPlyPointCloud) {
+  const SphereRun run;
+  const test::TempDir dir("voxplan-fuse-points");
+  FuseOutputPaths paths;
+  paths.points = (dir / "p.ply").string();
+  Result<FuseOutputs> out = WriteFuseOutputs(paths, run.volume, run.report, {}, {});
+  ASSERT_TRUE(out.ok()) << out.status().message();
+  const size_t n = out->mesh.num_vertices();
+  ASSERT_GT(n, 100u);
+  std::ifstream in(paths.points, std::ios::binary);
+  const std::string bytes(std::istreambuf_iterator<char>(in), {});
+  const size_t end = bytes.find("end_header\n");
+  ASSERT_NE(end, std::string::npos);
+  const std::string header = bytes.substr(0, end);
+  EXPECT_NE(header.find("element vertex " + std::to_string(n) + "\n"), std::string::npos);
+  EXPECT_EQ(header.find("element face"), std::string::npos);
+  const size_t body = end + 11, stride = 12 + 12 + 3;
+  ASSERT_EQ(bytes.size(), body + n * stride);
+  for (size_t i = 0; i < n; i += 37) {
+    float p[6];
+    std::memcpy(p, bytes.data() + body + i * stride, 24);
+    EXPECT_NEAR(Eigen::Vector3f(p[0], p[1], p[2] - 1.f).norm(), 0.3f, 0.01f) << i;
+    EXPECT_NEAR(Eigen::Vector3f(p[3], p[4], p[5]).norm(), 1.f, 1e-3f) << i;
+    EXPECT_EQ(uint8_t(bytes[body + i * stride + 24]), test::kExactRgb[0]);
+  }
 }
 
 TEST(FuseOutputs, EmptyPathsWriteNothingAndAFailureNamesTheFile) {
