@@ -36,21 +36,22 @@ int DatasetInfoCommand(const InfoOptions& o) {
   const DatasetInfo& info = (*dataset)->info();
   const PinholeCamera& c = info.camera;
 
-  std::printf("dataset     %s\n", info.root.c_str());
-  std::printf("format      %s\n", DatasetFormatName(info.format));
-  std::printf("frames      %zu\n", info.num_frames);
-  std::printf("image       %d x %d\n", c.width, c.height);
-  std::printf("intrinsics  fx %g  fy %g  cx %g  cy %g  (%s)\n", c.fx, c.fy, c.cx, c.cy,
-              info.intrinsics_source.c_str());
-  std::printf("depth scale %g units per metre\n", info.depth_scale);
-  std::printf("poses       %s\n", info.pose_source.c_str());
+  std::fprintf(stderr, "dataset     %s\n", info.root.c_str());
+  std::fprintf(stderr, "format      %s\n", DatasetFormatName(info.format));
+  std::fprintf(stderr, "frames      %zu\n", info.num_frames);
+  std::fprintf(stderr, "image       %d x %d\n", c.width, c.height);
+  std::fprintf(stderr, "intrinsics  fx %g  fy %g  cx %g  cy %g  (%s)\n", c.fx, c.fy, c.cx, c.cy,
+               info.intrinsics_source.c_str());
+  std::fprintf(stderr, "depth scale %g units per metre\n", info.depth_scale);
+  std::fprintf(stderr, "poses       %s\n", info.pose_source.c_str());
   if (info.frames_bad_pose > 0)
-    std::printf("bad poses   %zu of %zu frames (not rigid, e.g. ScanNet's -inf: no pose)\n",
-                info.frames_bad_pose, info.num_frames);
-  std::printf("colour      %s\n", info.has_color ? "yes" : "no");
-  if (!info.streams.empty()) std::printf("topics      %s\n", info.streams.c_str());
-  std::printf("warnings    %zu\n", info.warnings.size());
-  for (const std::string& w : info.warnings) std::printf("  %s\n", w.c_str());
+    std::fprintf(stderr,
+                 "bad poses   %zu of %zu frames (not rigid, e.g. ScanNet's -inf: no pose)\n",
+                 info.frames_bad_pose, info.num_frames);
+  std::fprintf(stderr, "colour      %s\n", info.has_color ? "yes" : "no");
+  if (!info.streams.empty()) std::fprintf(stderr, "topics      %s\n", info.streams.c_str());
+  std::fprintf(stderr, "warnings    %zu\n", info.warnings.size());
+  for (const std::string& w : info.warnings) std::fprintf(stderr, "  %s\n", w.c_str());
   std::fflush(stdout);
 
   nlohmann::json j;
@@ -87,16 +88,16 @@ int MapInfoCommand(const InfoOptions& o) {
   const double observed_percent =
       volume->num_voxels() > 0 ? 100.0 * double(observed) / double(volume->num_voxels()) : 0.0;
 
-  std::printf("map         %s\n", o.path.c_str());
-  std::printf("version     %u\n", header->version);
-  std::printf("voxel size  %g m\n", header->params.voxel_size_m);
-  std::printf("truncation  %g m\n", header->params.trunc_m);
-  std::printf("blocks      %llu (%zu voxels, %zu observed, %.1f%%)\n",
-              (unsigned long long)header->num_blocks, volume->num_voxels(), observed,
-              observed_percent);
-  std::printf("memory      %.3f MiB (%.1f bytes per voxel)\n", Mib(volume->MemoryBytes()),
-              TsdfVolume::BytesPerVoxel());
-  std::printf("file        %.3f MiB\n", Mib(ec ? 0 : size_t(file_bytes)));
+  std::fprintf(stderr, "map         %s\n", o.path.c_str());
+  std::fprintf(stderr, "version     %u\n", header->version);
+  std::fprintf(stderr, "voxel size  %g m\n", header->params.voxel_size_m);
+  std::fprintf(stderr, "truncation  %g m\n", header->params.trunc_m);
+  std::fprintf(stderr, "blocks      %llu (%zu voxels, %zu observed, %.1f%%)\n",
+               (unsigned long long)header->num_blocks, volume->num_voxels(), observed,
+               observed_percent);
+  std::fprintf(stderr, "memory      %.3f MiB (%.1f bytes per voxel)\n", Mib(volume->MemoryBytes()),
+               TsdfVolume::BytesPerVoxel());
+  std::fprintf(stderr, "file        %.3f MiB\n", Mib(ec ? 0 : size_t(file_bytes)));
   std::fflush(stdout);
 
   nlohmann::json j;

@@ -139,7 +139,7 @@ TEST(CliTest, InfoOnDataset) {
   EXPECT_EQ(j.at("camera").at("width").get<int>(), 640);
   EXPECT_FLOAT_EQ(j.at("camera").at("fy").get<float>(), -480.f);  // ICL's flipped y axis
   EXPECT_DOUBLE_EQ(j.at("depth_scale").get<double>(), 5000.0);
-  EXPECT_NE(info.out.find("format"), std::string::npos);  // readable lines before the JSON
+  EXPECT_NE(info.err.find("format"), std::string::npos);  // the table on stderr, as every summary
 }
 
 TEST(CliTest, MissingDatasetFolder) {

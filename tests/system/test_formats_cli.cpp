@@ -42,7 +42,7 @@ TEST(FormatsCli, InfoDescribesASensFile) {
   EXPECT_EQ(j.at("camera").at("width").get<int>(), 32);
   EXPECT_DOUBLE_EQ(j.at("depth_scale").get<double>(), 1000.0);
   EXPECT_TRUE(j.at("has_color").get<bool>());
-  EXPECT_NE(r.out.find("bad poses   1 of 6 frames"), std::string::npos) << Describe(r);
+  EXPECT_NE(r.err.find("bad poses   1 of 6 frames"), std::string::npos) << Describe(r);
   // The scene folder reads the same file.
   const RunResult folder = RunCli({"info", sens.parent_path().string()});
   ASSERT_EQ(folder.exit_code, 0) << Describe(folder);
@@ -117,7 +117,7 @@ TEST(FormatsCli, InfoAndFuseARosBag) {
   ASSERT_EQ(info.exit_code, 0) << Describe(info);
   EXPECT_EQ(info.last_json.at("format"), "rosbag");
   EXPECT_EQ(info.last_json.at("frames").get<int>(), 6);
-  EXPECT_NE(info.out.find("topics      depth /camera/depth/image (32FC1)"), std::string::npos)
+  EXPECT_NE(info.err.find("topics      depth /camera/depth/image (32FC1)"), std::string::npos)
       << Describe(info);
   EXPECT_NE(info.last_json.at("pose_source").get<std::string>().find("/tf"), std::string::npos);
 
