@@ -120,6 +120,22 @@ Result<double> JsonNumber(const nlohmann::json& obj, const std::string& key,
   return v;
 }
 
+Result<Frame> FrameFromEntry(const DatasetInfo& info, const std::vector<Entry>& entries, size_t i) {
+  if (i >= entries.size())
+    return InvalidArgument(info.root + ": frame " + std::to_string(i) + " out of range (" +
+                           std::to_string(entries.size()) + " frames)");
+  const Entry& e = entries[i];
+  Frame frame;
+  frame.index = i;
+  frame.timestamp = e.timestamp;
+  frame.T_W_C = e.T_W_C;
+  frame.pose_rejected = e.pose_rejected;
+  frame.pose_rejected_why = e.pose_rejected_why;
+  frame.depth_path = e.depth_path;
+  frame.color_path = e.color_path;
+  return frame;
+}
+
 namespace {
 
 // ---------------------------------------------------------------------------------------------
@@ -135,18 +151,10 @@ class ListDataset final : public Dataset {
   std::vector<std::string> InputFiles() const override;
 
   Result<Frame> Load(size_t i) const override {
-    if (i >= entries_.size())
-      return InvalidArgument(info_.root + ": frame " + std::to_string(i) + " out of range (" +
-                             std::to_string(entries_.size()) + " frames)");
+    Result<Frame> listed = FrameFromEntry(info_, entries_, i);
+    if (!listed.ok()) return listed.status();
+    Frame frame = std::move(listed).value();
     const Entry& e = entries_[i];
-    Frame frame;
-    frame.index = i;
-    frame.timestamp = e.timestamp;
-    frame.T_W_C = e.T_W_C;
-    frame.pose_rejected = e.pose_rejected;
-    frame.pose_rejected_why = e.pose_rejected_why;
-    frame.depth_path = e.depth_path;
-    frame.color_path = e.color_path;
     auto depth = ReadDepthPng(e.depth_path, info_.depth_scale);
     if (!depth.ok()) return depth.status();
     frame.depth = std::move(depth).value();

@@ -42,6 +42,11 @@ struct Entry {
   std::string origin;  // "file:line" the entry came from, for error messages
 };
 
+// Frame i of a listing with what its entry says (index, time, pose or why it has none, file
+// names) and no images yet, or the out-of-range error naming the dataset: each Dataset's Load
+// then decodes the images its own way.
+Result<Frame> FrameFromEntry(const DatasetInfo& info, const std::vector<Entry>& entries, size_t i);
+
 // What a reader found, before options and common checks are applied.
 struct Draft {
   DatasetFormat format = DatasetFormat::kAuto;

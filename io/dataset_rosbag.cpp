@@ -399,18 +399,10 @@ class BagDataset final : public Dataset {
   std::vector<std::string> InputFiles() const override { return {bag_->path()}; }
 
   Result<Frame> Load(size_t i) const override {
-    if (i >= entries_.size())
-      return InvalidArgument(info_.root + ": frame " + std::to_string(i) + " out of range (" +
-                             std::to_string(entries_.size()) + " frames)");
+    Result<Frame> listed = FrameFromEntry(info_, entries_, i);
+    if (!listed.ok()) return listed.status();
+    Frame frame = std::move(listed).value();
     const Entry& e = entries_[i];
-    Frame frame;
-    frame.index = i;
-    frame.timestamp = e.timestamp;
-    frame.T_W_C = e.T_W_C;
-    frame.pose_rejected = e.pose_rejected;
-    frame.pose_rejected_why = e.pose_rejected_why;
-    frame.depth_path = e.depth_path;
-    frame.color_path = e.color_path;
     Result<std::string> bytes = bag_->Read(frames_[i].depth_ref);
     if (!bytes.ok()) return bytes.status();
     Result<ros1::Image> image = ros1::ParseImage(*bytes);

@@ -40,18 +40,9 @@ class SensDataset final : public Dataset {
   std::vector<std::string> InputFiles() const override { return {index_.path}; }
 
   Result<Frame> Load(size_t i) const override {
-    if (i >= entries_.size())
-      return InvalidArgument(info_.root + ": frame " + std::to_string(i) + " out of range (" +
-                             std::to_string(entries_.size()) + " frames)");
-    const Entry& e = entries_[i];
-    Frame frame;
-    frame.index = i;
-    frame.timestamp = e.timestamp;
-    frame.T_W_C = e.T_W_C;
-    frame.pose_rejected = e.pose_rejected;
-    frame.pose_rejected_why = e.pose_rejected_why;
-    frame.depth_path = e.depth_path;
-    frame.color_path = e.color_path;
+    Result<Frame> listed = FrameFromEntry(info_, entries_, i);
+    if (!listed.ok()) return listed.status();
+    Frame frame = std::move(listed).value();
     Result<DepthImage> depth = ReadSensDepth(index_, i, info_.depth_scale);
     if (!depth.ok()) return depth.status();
     frame.depth = std::move(depth).value();

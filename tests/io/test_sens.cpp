@@ -6,14 +6,13 @@
 
 #include <cmath>
 #include <filesystem>
-#include <optional>
 #include <string>
-#include <thread>
 #include <vector>
 
 #include "io/color_registration.h"
 #include "io/dataset.h"
 #include "io/sens_file.h"
+#include "tests/io/dataset_checks.h"
 #include "tests/io/sens_fixture.h"
 #include "tests/support/test_support.h"
 
@@ -213,24 +212,7 @@ TEST(Sens, LoadsFromSeveralThreadsMatchOneThread) {
   const fs::path path = WriteScan(dir, test::MakeWallScan(8, 2));
   auto ds = OpenDataset(path.string());
   ASSERT_TRUE(ds.ok()) << ds.status().message();
-  const size_t n = (*ds)->info().num_frames;
-  std::vector<Frame> one;
-  for (size_t i = 0; i < n; ++i) one.push_back((*ds)->Load(i).value());
-  std::vector<std::optional<Frame>> many(n);
-  std::vector<std::thread> threads;
-  for (size_t t = 0; t < 4; ++t)
-    threads.emplace_back([&, t] {
-      for (size_t i = t; i < n; i += 4) {
-        Result<Frame> f = (*ds)->Load(i);
-        if (f.ok()) many[i] = std::move(f).value();
-      }
-    });
-  for (std::thread& t : threads) t.join();
-  for (size_t i = 0; i < n; ++i) {
-    ASSERT_TRUE(many[i].has_value()) << i;
-    EXPECT_EQ(many[i]->depth.data, one[i].depth.data) << i;
-    EXPECT_EQ(many[i]->color.data, one[i].color.data) << i;
-  }
+  test::ExpectThreadedLoadsMatchOneThread(**ds);
 }
 
 }  // namespace

@@ -54,4 +54,20 @@ std::string Describe(const RunResult& r) {
   return "exit " + std::to_string(r.exit_code) + "\nstdout:\n" + r.out + "\nstderr:\n" + r.err;
 }
 
+std::filesystem::path IclDir() { return SharedDataDir() / "rgbd" / "iclnuim_office_traj0"; }
+
+void CopyIclFrames(const std::filesystem::path& to, int frames) {
+  namespace fs = std::filesystem;
+  fs::create_directories(to / "depth");
+  fs::create_directories(to / "rgb");
+  std::ofstream assoc(to / "associations.txt");
+  for (int id = 1; id <= frames; ++id) {
+    const std::string n = std::to_string(id);
+    assoc << n << " depth/" << n << ".png " << n << " rgb/" << n << ".jpg\n";
+    fs::copy_file(IclDir() / "depth" / (n + ".png"), to / "depth" / (n + ".png"));
+    fs::copy_file(IclDir() / "rgb" / (n + ".jpg"), to / "rgb" / (n + ".jpg"));
+  }
+  fs::copy_file(IclDir() / "traj0.gt.freiburg", to / "traj0.gt.freiburg");
+}
+
 }  // namespace voxplan::test

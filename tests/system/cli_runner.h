@@ -19,4 +19,9 @@ std::string ReadAll(const std::filesystem::path& path);
 RunResult RunCli(const std::vector<std::string>& args, const std::string& env_prefix = "");
 std::string Describe(const RunResult& r);  // exit code and both streams, for failure messages
 
+// The shared ICL-NUIM sequence, and a copy of its first `frames` frames (associations, depth,
+// colour, ground truth) into `to`, for tests that break a frame of their own.
+std::filesystem::path IclDir();
+void CopyIclFrames(const std::filesystem::path& to, int frames);
+
 }  // namespace voxplan::test

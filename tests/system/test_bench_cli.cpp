@@ -29,7 +29,7 @@ using test::ReadAll;
 using test::RunCli;
 using test::RunResult;
 
-fs::path IclDir() { return test::SharedDataDir() / "rgbd" / "iclnuim_office_traj0"; }
+using test::IclDir;
 
 TEST(BenchCliTest, FusionOnTenIclFrames) {
   const test::TempDir dir("voxplan-bench");

@@ -20,7 +20,7 @@ using test::Describe;
 using test::RunCli;
 using test::RunResult;
 
-fs::path IclDir() { return test::SharedDataDir() / "rgbd" / "iclnuim_office_traj0"; }
+using test::IclDir;
 fs::path KitchenDir() { return test::SharedDataDir() / "rgbd" / "7scenes_redkitchen"; }
 
 // Runs the command and expects a usage error, quickly, whose message holds every `expected`.

@@ -27,7 +27,7 @@ using test::ReadAll;
 using test::RunCli;
 using test::RunResult;
 
-fs::path IclDir() { return test::SharedDataDir() / "rgbd" / "iclnuim_office_traj0"; }
+using test::IclDir;
 
 // A small valid map written through the library, for tests that need one without fusing.
 void WriteSmallMap(const fs::path& path) {
@@ -208,17 +208,7 @@ TEST(CliTest, FailedRunLeavesExistingMapUntouched) {
 
   // Fails during the frame loop: a corrupt depth image.
   const fs::path broken = dir / "icl_broken";
-  fs::create_directories(broken / "depth");
-  fs::create_directories(broken / "rgb");
-  std::ofstream assoc(broken / "associations.txt");
-  for (int id = 1; id <= 6; ++id) {
-    const std::string n = std::to_string(id);
-    assoc << n << " depth/" << n << ".png " << n << " rgb/" << n << ".jpg\n";
-    fs::copy_file(IclDir() / "depth" / (n + ".png"), broken / "depth" / (n + ".png"));
-    fs::copy_file(IclDir() / "rgb" / (n + ".jpg"), broken / "rgb" / (n + ".jpg"));
-  }
-  assoc.close();
-  fs::copy_file(IclDir() / "traj0.gt.freiburg", broken / "traj0.gt.freiburg");
+  test::CopyIclFrames(broken, 6);
   const fs::path bad = broken / "depth" / "4.png";
   fs::resize_file(bad, fs::file_size(bad) / 3);
 

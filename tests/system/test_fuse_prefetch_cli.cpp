@@ -21,7 +21,7 @@ using test::RunCli;
 using test::RunResult;
 
 fs::path Kitchen() { return test::SharedDataDir() / "rgbd" / "7scenes_redkitchen"; }
-fs::path IclDir() { return test::SharedDataDir() / "rgbd" / "iclnuim_office_traj0"; }
+using test::IclDir;
 
 TEST(FusePrefetchCli, PrefetchingWritesTheSameBytes) {
   const test::TempDir dir("voxplan-prefetch-cli");
@@ -51,17 +51,7 @@ TEST(FusePrefetchCli, PrefetchingWritesTheSameBytes) {
 TEST(FusePrefetchCli, ABadFrameFailsTheRunTheSameWayWithNothingWritten) {
   const test::TempDir dir("voxplan-prefetch-bad");
   const fs::path broken = dir / "icl";
-  fs::create_directories(broken / "depth");
-  fs::create_directories(broken / "rgb");
-  std::ofstream assoc(broken / "associations.txt");
-  for (int id = 1; id <= 14; ++id) {
-    const std::string n = std::to_string(id);
-    assoc << n << " depth/" << n << ".png " << n << " rgb/" << n << ".jpg\n";
-    fs::copy_file(IclDir() / "depth" / (n + ".png"), broken / "depth" / (n + ".png"));
-    fs::copy_file(IclDir() / "rgb" / (n + ".jpg"), broken / "rgb" / (n + ".jpg"));
-  }
-  assoc.close();
-  fs::copy_file(IclDir() / "traj0.gt.freiburg", broken / "traj0.gt.freiburg");
+  test::CopyIclFrames(broken, 14);
   const fs::path bad = broken / "rgb" / "9.jpg";  // colour this time; frame 8
   fs::resize_file(bad, fs::file_size(bad) / 2);
   std::string first_error;

@@ -26,7 +26,7 @@ void WriteTextFile(const fs::path& path, const std::string& text) {
   std::ofstream(path, std::ios::binary) << text;
 }
 
-fs::path IclDir() { return test::SharedDataDir() / "rgbd" / "iclnuim_office_traj0"; }
+using test::IclDir;
 
 // The first three ICL-NUIM frames, copied: a dataset the tests may try to damage.
 fs::path CopyIcl(const fs::path& dir) {
