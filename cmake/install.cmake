@@ -15,8 +15,8 @@ set(VOXPLAN_INSTALL_PKGCONFIGDIR ${CMAKE_INSTALL_LIBDIR}/pkgconfig)
 # The exported libraries (voxplan_<name> as voxplan::<name>) and the folders of their headers.
 # eval links CGAL, which is GPL, and explore sits on eval: those two are an export set of their
 # own, the `eval` component, so that find_package(voxplan) alone never drags CGAL into a consumer.
-set(exported core fusion io pipeline)
-set(header_folders core fusion io pipeline)
+set(exported core fusion io pipeline distributed)
+set(header_folders core fusion io pipeline distributed)
 set(exported_gpl)
 if(NOT VOXPLAN_ENGINE_ONLY)
   list(APPEND exported viewer planning sim planner_api plugin_host)
@@ -128,10 +128,16 @@ voxplan_pkg_config(voxplan-fusion "TSDF integration, tracking, marching cubes"
   REQUIRES voxplan-core LIBS ${pc_libdir} -lvoxplan_fusion -lopencv_imgproc -lopencv_core)
 voxplan_pkg_config(voxplan-io "dataset readers, trajectories, images, mesh and map files"
   REQUIRES voxplan-core libpng libjpeg zlib libdeflate assimp LIBS ${pc_libdir} -lvoxplan_io
-  -lrosbag_storage -lrostime -lroscpp_serialization -lcpp_common -lconsole_bridge)
+  -lrosbag_storage -lrostime -lroscpp_serialization -lcpp_common -lconsole_bridge -lroslz4 -lbz2)
 voxplan_pkg_config(voxplan-pipeline "whole fusion jobs over a dataset"
   REQUIRES voxplan-fusion voxplan-io LIBS ${pc_libdir} -lvoxplan_pipeline)
-set(umbrella voxplan-pipeline)
+set(pc_mpi "")
+if(VOXPLAN_HAVE_MPI)
+  set(pc_mpi ompi-c)  # Debian's OpenMPI
+endif()
+voxplan_pkg_config(voxplan-distributed "sharded fusion over MPI ranks, sharded maps, the task farm"
+  REQUIRES voxplan-pipeline nlohmann_json ${pc_mpi} LIBS ${pc_libdir} -lvoxplan_distributed)
+set(umbrella voxplan-pipeline voxplan-distributed)
 if(NOT VOXPLAN_ENGINE_ONLY)
   voxplan_pkg_config(voxplan-viewer "CPU shading of ray casts and meshes, orbits, top-down maps"
     REQUIRES voxplan-core LIBS ${pc_libdir} -lvoxplan_viewer)
@@ -172,6 +178,9 @@ set(CPACK_DEBIAN_DEV_PACKAGE_NAME voxplan-dev)
 set(CPACK_DEBIAN_DEV_PACKAGE_SECTION libdevel)
 set(dev_depends libeigen3-dev libtbb-dev libpng-dev libjpeg62-turbo-dev libdeflate-dev
   libassimp-dev nlohmann-json3-dev libopencv-imgproc-dev librosbag-storage-dev)
+if(VOXPLAN_HAVE_MPI)
+  list(APPEND dev_depends libopenmpi-dev)
+endif()
 if(NOT VOXPLAN_ENGINE_ONLY)
   list(APPEND dev_depends liboctomap-dev libembree-dev)
   # Only the eval component needs CGAL.

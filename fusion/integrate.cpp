@@ -67,6 +67,10 @@ Status IntegrateParams::Validate() const {
   // The range is (0, kMaxWeight]: 0 itself is refused below.
   VOXPLAN_RETURN_IF_ERROR(bounds::CheckRange("max weight", max_weight, 0.0, kMaxWeight));
   if (max_weight == 0.f) return InvalidArgument("max weight must be positive");
+  if (shard.ranks < 1 || shard.ranks > kMaxShardRanks || shard.rank >= shard.ranks)
+    return InvalidArgument("shard rank " + std::to_string(shard.rank) + " of " +
+                           std::to_string(shard.ranks) + " ranks is out of range (1 to " +
+                           std::to_string(kMaxShardRanks) + " ranks)");
   return Status::Ok();
 }
 
@@ -398,6 +402,11 @@ Result<IntegrateStats> IntegrateFrame(ImageView<float> depth, ImageView<uint32_t
   std::vector<BlockIndex> band =
       CollectBlocks(depth, camera, T_W_C, params, volume.params(), params.carve_free_space,
                     params.carve_free_space ? nullptr : &valid_pixels);
+  if (!params.shard.whole())
+    band.erase(std::remove_if(band.begin(), band.end(),
+                              [&](BlockIndex b) { return !params.shard.Owns(b); }),
+               band.end());
+  stats.collect_ms = clock.ElapsedMs();
   // Look the blocks up in parallel (concurrent finds are safe); only the missing ones are
   // allocated, serially, in band order.
   std::vector<TsdfBlock*> blocks(band.size());

@@ -7,6 +7,7 @@
 #include "core/camera.h"
 #include "core/image.h"
 #include "core/pose.h"
+#include "core/shard.h"
 #include "core/status.h"
 #include "core/volume.h"
 
@@ -37,6 +38,9 @@ struct IntegrateParams {
   // (OctoMap's maxrange). Real sensors return such readings; their noise keeps them out of the
   // model, so they update only voxels still unobserved or free, never a fused surface.
   bool clear_beyond_max_depth = false;
+  // A map split over ranks (distributed/): only the blocks this rank owns are allocated and
+  // updated; every rank still walks the frame's whole band to find them.
+  ShardSpec shard;
 
   // Depth range within [0, bounds::kDepthMaxM] with min < max, max weight in (0, kMaxWeight],
   // a positive carve ray spacing; InvalidArgument naming the value and the range otherwise.
@@ -49,7 +53,8 @@ struct IntegrateStats {
   // New blocks the volume's memory budget refused: their voxels were not updated this frame.
   size_t blocks_refused = 0;
   size_t valid_pixels = 0;
-  double allocate_ms = 0.0;
+  double collect_ms = 0.0;   // finding the band's blocks: repeated by every rank of a split map
+  double allocate_ms = 0.0;  // collecting, looking up and allocating them
   double update_ms = 0.0;
   // Every block this frame updated, sorted (BlockIndex order) without duplicates, so maps
   // derived from the volume can update incrementally.
@@ -64,6 +69,7 @@ Result<IntegrateStats> IntegrateFrame(const DepthImage& depth, const ColorImage&
                                       const PinholeCamera& camera, const Pose3f& T_W_C,
                                       const IntegrateParams& params, TsdfVolume& volume);
 
+// With params.shard, only the blocks it owns are updated (the band functions below ignore it).
 // Blocks within the truncation band of every valid pixel, sorted and without duplicates.
 std::vector<BlockIndex> BlocksInTruncationBand(const DepthImage& depth, const PinholeCamera& camera,
                                                const Pose3f& T_W_C, const IntegrateParams& params,

@@ -143,12 +143,30 @@ Mesh Assemble(const std::vector<const BlockMesh*>& parts, const MeshParams& para
 }  // namespace
 
 Mesh ExtractMesh(const TsdfVolume& volume, const MeshParams& params) {
-  std::vector<BlockMesh> parts;
-  MeshBlocks(volume, volume.SortedBlockIndices(), params, parts);
+  const std::vector<BlockMesh> parts = MeshBlockPieces(volume, volume.SortedBlockIndices(), params);
   std::vector<const BlockMesh*> pointers;
   pointers.reserve(parts.size());
   for (const BlockMesh& part : parts) pointers.push_back(&part);
   return Assemble(pointers, params);
+}
+
+std::vector<BlockMesh> MeshBlockPieces(const TsdfVolume& volume,
+                                       const std::vector<BlockIndex>& blocks,
+                                       const MeshParams& params) {
+  std::vector<BlockMesh> parts;
+  MeshBlocks(volume, blocks, params, parts);
+  return parts;
+}
+
+Mesh AssembleMeshPieces(const std::vector<const BlockMesh*>& pieces_in_block_order,
+                        const MeshParams& params) {
+  return Assemble(pieces_in_block_order, params);
+}
+
+std::array<BlockIndex, 7> MeshStencilNeighbours(BlockIndex b) {
+  std::array<BlockIndex, 7> out;
+  for (int n = 1; n < 8; ++n) out[n - 1] = {b.x + (n & 1), b.y + ((n >> 1) & 1), b.z + (n >> 2)};
+  return out;
 }
 
 IncrementalMesher::IncrementalMesher(const MeshParams& params) : params_(params) {}

@@ -4,6 +4,7 @@
 // parallel over blocks and deterministic (same volume -> same mesh bytes, whatever the thread
 // count). The mesh has no zero-area triangle, no two vertices at one position and no vertex
 // that no triangle uses (fusion/README.md).
+#include <array>
 #include <map>
 #include <memory>
 #include <vector>
@@ -21,8 +22,21 @@ struct MeshParams {
 Mesh ExtractMesh(const TsdfVolume& volume, const MeshParams& params = {});
 
 namespace internal {
-struct BlockMesh;
+struct BlockMesh;  // fusion/mesh_block.h
 }
+
+// Meshing a map split over ranks (distributed/): each rank meshes the blocks it owns, with
+// copies of the neighbours their cubes read (MeshStencilNeighbours) that other ranks own, and
+// one rank welds every rank's pieces in block order. ExtractMesh(volume) is
+// AssembleMeshPieces of MeshBlockPieces over volume.SortedBlockIndices(), so the split mesh has
+// the same bytes.
+std::vector<internal::BlockMesh> MeshBlockPieces(const TsdfVolume& volume,
+                                                 const std::vector<BlockIndex>& blocks,
+                                                 const MeshParams& params);
+Mesh AssembleMeshPieces(const std::vector<const internal::BlockMesh*>& pieces_in_block_order,
+                        const MeshParams& params);
+// The blocks whose voxels the cubes of `b` read besides its own: its +x/+y/+z neighbours.
+std::array<BlockIndex, 7> MeshStencilNeighbours(BlockIndex b);
 
 // Meshing that keeps each block's piece and redoes only the pieces a frame can have changed:
 // a block's cubes read it and its +x/+y/+z neighbours, so a changed block dirties itself and

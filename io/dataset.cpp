@@ -247,6 +247,17 @@ Result<DatasetInfo> FinishInfo(Draft& d, const DatasetOptions& options) {
   }
   info.has_color = std::any_of(d.entries.begin(), d.entries.end(),
                                [](const Entry& e) { return !e.color_path.empty(); });
+  if (d.stated_up != WorldUp::kUnknown) {
+    info.up = d.stated_up;
+    info.up_source = d.up_convention;
+  } else {
+    WorldUpEstimator votes(info.camera.fy);
+    for (const Entry& e : d.entries)
+      if (e.T_W_C) votes.Add(e.T_W_C->linear());
+    const WorldUpEstimator::Estimate estimate = votes.Result();
+    info.up = estimate.up;
+    info.up_source = estimate.Describe();
+  }
   return info;
 }
 

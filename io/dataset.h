@@ -11,6 +11,7 @@
 #include "core/image.h"
 #include "core/pose.h"
 #include "core/status.h"
+#include "io/world_up.h"
 
 namespace voxplan {
 
@@ -64,6 +65,11 @@ struct DatasetInfo {
   size_t frames_bad_pose = 0;         // listed poses that are not rigid (-inf), kept without one
   std::vector<std::string> warnings;  // one line each, e.g. frames dropped for lack of poses
   std::string streams;  // ROS bags: the topics read, "depth /camera/depth/image (32FC1), ..."
+  // The world's up axis: the format's convention where it states one (ICL-NUIM +y, Replica and
+  // ScanNet +z, ROS bags +z by REP 103), else estimated from the listed poses
+  // (WorldUpEstimator: TUM, 7-Scenes, 3DMatch, Redwood); unknown when they do not tell.
+  WorldUp up = WorldUp::kUnknown;
+  std::string up_source;  // "ICL-NUIM convention ...", "estimated from 400 poses (...)", ...
 };
 
 // Why a frame has no pose although its dataset lists one for it (or around it).

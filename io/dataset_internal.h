@@ -62,6 +62,10 @@ struct Draft {
   std::string empty_message;   // why there are no frames, when there are none
   size_t bad_poses = 0;        // listed poses rejected as kBadValues; Finish warns once
   std::string first_bad_pose;  // "file:line: reason" of the first
+  // The world's up axis where the format states one, and the convention's name; otherwise
+  // FinishInfo estimates it from the entries' poses.
+  WorldUp stated_up = WorldUp::kUnknown;
+  std::string up_convention;
 };
 
 inline void SetIntrinsics(Draft& d, const float (&k)[4]) { std::copy(k, k + 4, d.intrinsics); }

@@ -17,6 +17,9 @@ Result<Draft> ReadReplica(const fs::path& root) {
   Draft d;
   d.format = DatasetFormat::kReplica;
   d.root = root.string();
+  // The poses are in the frame of Replica's meshes, which are z-up (shared data README).
+  d.stated_up = WorldUp::kPlusZ;
+  d.up_convention = "Replica convention (its meshes and poses are z-up)";
   std::error_code ec;
 
   fs::path scene;

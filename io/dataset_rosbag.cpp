@@ -753,6 +753,11 @@ Result<std::unique_ptr<Dataset>> OpenRosBag(const fs::path& bag_file,
                     " without colour within 0.02 s, " + std::to_string(no_pose) +
                     " without a pose around them)";
 
+  if (!s.pose.empty()) {
+    // REP 103: ROS world frames (map, odom, world) are x forward / east, y left, z up.
+    d.stated_up = WorldUp::kPlusZ;
+    d.up_convention = "ROS convention (REP 103: world frames are z-up)";
+  }
   Result<DatasetInfo> finished = FinishInfo(d, options);
   if (!finished.ok()) return finished.status();
   DatasetInfo info = std::move(finished).value();

@@ -82,6 +82,10 @@ Result<std::unique_ptr<Dataset>> OpenScanNet(const fs::path& sens_file,
   SetIntrinsics(d, k);
   d.intrinsics_source = path + ": depth intrinsics";
   d.pose_source = path;
+  // ScanNet aligns every scan and its camera poses to a frame with z up and the floor in the xy
+  // plane (Dai et al., CVPR 2017; the axisAlignment matrices then only turn about z).
+  d.stated_up = WorldUp::kPlusZ;
+  d.up_convention = "ScanNet convention (scans are aligned z-up)";
 
   // Colour is all or nothing: a file whose header has a colour size must carry it every frame.
   const bool has_color = h.color_width > 0 && index->frames.front().color_bytes > 0;

@@ -234,6 +234,9 @@ Result<Draft> ReadIclNuim(const fs::path& root) {
   d.depth_scale = 5000.0;
   SetIntrinsics(d, kIclNuim);
   d.intrinsics_source = "default (ICL-NUIM: fx 481.2 fy -480 cx 319.5 cy 239.5)";
+  // Its scenes are modelled y-up; the y-flipped camera (fy < 0) has +y up in its upright images.
+  d.stated_up = WorldUp::kPlusY;
+  d.up_convention = "ICL-NUIM convention (its world is y-up)";
 
   const std::string assoc_txt = (root / "associations.txt").string();
   auto assoc = ReadTextFile(assoc_txt);

@@ -20,8 +20,16 @@ static_assert(std::endian::native == std::endian::little, "map files assume a li
 
 namespace {
 
+// The header: magic, version (uint32), voxel size and truncation (float32 metres), block count
+// (uint64), then from version 2 the world's up axis (uint32, WorldUp's value: 0 unknown, 1 +x,
+// 2 -x, 3 +y, 4 -y, 5 +z, 6 -z). Version 1 files end their header before the up axis.
 constexpr char kMagic[8] = {'V', 'X', 'P', 'L', 'M', 'A', 'P', '\0'};
-constexpr size_t kHeaderBytes = 8 + 4 + 4 + 4 + 8;
+constexpr size_t kHeaderBytesV1 = 8 + 4 + 4 + 4 + 8;
+constexpr size_t kUpOffset = kHeaderBytesV1;
+constexpr size_t kMaxHeaderBytes = kHeaderBytesV1 + 4;
+constexpr size_t HeaderBytes(uint32_t version) {
+  return version >= 2 ? kMaxHeaderBytes : kHeaderBytesV1;
+}
 constexpr size_t kBlockRecordBytes = 3 * sizeof(int32_t) + sizeof(TsdfBlock);
 constexpr size_t kChecksumBytes = 8;
 static_assert(sizeof(kMagic) == 8);
@@ -82,25 +90,36 @@ Status CheckParams(const VolumeParams& p) {
 // Parses and checks the header against the file's size. Messages name what is wrong; callers
 // add the file name.
 Result<MapHeader> ParseHeader(const char* bytes, size_t available, uint64_t file_size) {
-  if (available < kHeaderBytes || file_size < kHeaderBytes)
+  const auto truncated = [&] {
     return CorruptData("truncated: " + std::to_string(file_size) +
                        " bytes, shorter than the map header");
+  };
+  if (available < kHeaderBytesV1 || file_size < kHeaderBytesV1) return truncated();
   if (std::memcmp(bytes, kMagic, sizeof(kMagic)) != 0)
     return CorruptData("not a voxplan map (bad magic)");
   MapHeader header;
   header.version = Get<uint32_t>(bytes + 8);
-  if (header.version != kMapFormatVersion)
+  if (header.version < kMapFormatOldestVersion || header.version > kMapFormatVersion)
     return Unsupported("format version " + std::to_string(header.version) +
-                       ", this build reads version " + std::to_string(kMapFormatVersion));
+                       ", this build reads versions " + std::to_string(kMapFormatOldestVersion) +
+                       " to " + std::to_string(kMapFormatVersion));
+  const size_t header_bytes = HeaderBytes(header.version);
+  if (available < header_bytes || file_size < header_bytes) return truncated();
   header.params.voxel_size_m = Get<float>(bytes + 12);
   header.params.trunc_m = Get<float>(bytes + 16);
   header.num_blocks = Get<uint64_t>(bytes + 20);
+  if (header.version >= 2) {
+    const uint32_t code = Get<uint32_t>(bytes + kUpOffset);
+    const std::optional<WorldUp> up = WorldUpFromCode(code);
+    if (!up) return CorruptData("invalid up axis " + std::to_string(code) + " (0 to 6)");
+    header.up = *up;
+  }
   VOXPLAN_RETURN_IF_ERROR(CheckParams(header.params));
   // Compared by division first so a corrupt count cannot overflow the expected size.
-  const uint64_t payload = file_size - kHeaderBytes;
+  const uint64_t payload = file_size - header_bytes;
   const bool too_many = header.num_blocks > payload / kBlockRecordBytes;
   const uint64_t expected =
-      too_many ? 0 : kHeaderBytes + header.num_blocks * kBlockRecordBytes + kChecksumBytes;
+      too_many ? 0 : header_bytes + header.num_blocks * kBlockRecordBytes + kChecksumBytes;
   if (too_many || file_size < expected)
     return CorruptData("truncated: the header announces " + std::to_string(header.num_blocks) +
                        " blocks but the file has only " + std::to_string(file_size) + " bytes");
@@ -125,7 +144,7 @@ Result<File> OpenForReading(const std::string& path) {
   return f;
 }
 
-Status WriteMapFile(const TsdfVolume& volume, const std::vector<BlockIndex>& blocks,
+Status WriteMapFile(const TsdfVolume& volume, const std::vector<BlockIndex>& blocks, WorldUp up,
                     const std::string& path) {
   File f(std::fopen(path.c_str(), "wb"));
   if (!f) return IoError("cannot open " + path + " for writing: " + std::strerror(errno));
@@ -143,6 +162,7 @@ Status WriteMapFile(const TsdfVolume& volume, const std::vector<BlockIndex>& blo
   Put(buffer, volume.params().voxel_size_m);
   Put(buffer, volume.params().trunc_m);
   Put(buffer, uint64_t(blocks.size()));
+  Put(buffer, uint32_t(up));
   for (const BlockIndex& b : blocks) {
     const TsdfBlock* block = volume.FindBlock(b);
     assert(block);
@@ -168,10 +188,11 @@ bool IsMapPath(const std::string& path) {
   return std::filesystem::path(path).extension() == ".vpmap";
 }
 
-Status SaveMap(const TsdfVolume& volume, const std::string& path) {
+Status SaveMap(const TsdfVolume& volume, const std::string& path, WorldUp up) {
+  if (!WorldUpFromCode(uint32_t(up))) return InvalidArgument("invalid up axis for " + path);
   const std::vector<BlockIndex> blocks = volume.SortedBlockIndices();
-  return WriteAtomically(path,
-                         [&](const std::string& tmp) { return WriteMapFile(volume, blocks, tmp); });
+  return WriteAtomically(
+      path, [&](const std::string& tmp) { return WriteMapFile(volume, blocks, up, tmp); });
 }
 
 Result<MapHeader> ReadMapHeader(const std::string& path) {
@@ -179,14 +200,14 @@ Result<MapHeader> ReadMapHeader(const std::string& path) {
   if (!size.ok()) return size.status();
   Result<File> f = OpenForReading(path);
   if (!f.ok()) return f.status();
-  char bytes[kHeaderBytes];
+  char bytes[kMaxHeaderBytes];
   const size_t got = std::fread(bytes, 1, sizeof(bytes), f->get());
   Result<MapHeader> header = ParseHeader(bytes, got, *size);
   if (!header.ok()) return header.status().WithContext("map " + path);
   return header;
 }
 
-Result<TsdfVolume> LoadMap(const std::string& path) {
+Result<TsdfVolume> LoadMap(const std::string& path, WorldUp* up) {
   const Result<uint64_t> size = FileSize(path);
   if (!size.ok()) return size.status();
   Result<File> file = OpenForReading(path);
@@ -195,11 +216,15 @@ Result<TsdfVolume> LoadMap(const std::string& path) {
   const std::string context = "map " + path;
 
   Fnv1a64 hash;
-  char header_bytes[kHeaderBytes];
+  // As many bytes as the longest header; a shorter (older) one is followed by the blocks.
+  char header_bytes[kMaxHeaderBytes];
   const size_t got = std::fread(header_bytes, 1, sizeof(header_bytes), f);
   const Result<MapHeader> header = ParseHeader(header_bytes, got, *size);
   if (!header.ok()) return header.status().WithContext(context);
-  hash.Update(header_bytes, sizeof(header_bytes));
+  const size_t header_size = HeaderBytes(header->version);
+  hash.Update(header_bytes, header_size);
+  if (got != header_size && std::fseek(f, long(header_size), SEEK_SET) != 0)
+    return IoError("cannot read " + path + ": " + std::strerror(errno));
 
   // Blocks stream straight into the volume. Structural problems are remembered rather than
   // returned at once, so a damaged file is reported as a checksum mismatch (the likelier cause)
@@ -237,6 +262,7 @@ Result<TsdfVolume> LoadMap(const std::string& path) {
   if (stored != hash.value())
     return CorruptData("checksum mismatch (the file is damaged)").WithContext(context);
   if (problem) return problem->WithContext(context);
+  if (up) *up = header->up;
   return volume;
 }
 

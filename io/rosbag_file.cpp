@@ -8,10 +8,11 @@
 #include <cstring>
 #include <exception>
 #include <filesystem>
-#include <fstream>
 #include <map>
 #include <mutex>
 #include <utility>
+
+#include "io/rosbag_check.h"
 
 namespace voxplan {
 namespace {
@@ -84,14 +85,8 @@ const std::vector<BagTopic>& RosBagFile::topics() const { return impl_->topics; 
 
 Result<std::unique_ptr<RosBagFile>> RosBagFile::Open(const std::string& path) {
   SilenceRosbag();
-  {
-    std::ifstream in(path, std::ios::binary);
-    if (!in) return IoError(path + ": cannot open");
-    char magic[9] = {};
-    in.read(magic, 9);
-    if (in.gcount() < 9 || std::memcmp(magic, "#ROSBAG V", 9) != 0)
-      return CorruptData(path + ": not a ROS 1 bag (no \"#ROSBAG V\" at its start)");
-  }
+  // rosbag_storage trusts the file's lengths: its structure is checked first (rosbag_check.h).
+  VOXPLAN_RETURN_IF_ERROR(CheckRosBagStructure(path));
   auto impl = std::make_unique<Impl>();
   impl->path = path;
   try {

@@ -25,7 +25,8 @@ inline constexpr uint32_t kMaxBagMessageBytes = (uint32_t(1) << 28) + (uint32_t(
 
 class RosBagFile {
  public:
-  // Opens and indexes the bag; refuses a file that does not start with "#ROSBAG V".
+  // Checks the bag's structure (io/rosbag_check.h: every length against the file, each index
+  // entry against its chunk; this reads the whole file once), then opens and indexes it.
   static Result<std::unique_ptr<RosBagFile>> Open(const std::string& path);
   ~RosBagFile();
   RosBagFile(const RosBagFile&) = delete;

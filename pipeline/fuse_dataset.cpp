@@ -105,7 +105,7 @@ std::optional<Pose3f> DatasetPose(const Frame& frame, const FuseParams& params,
 
 Result<FuseReport> FuseDataset(const Dataset& dataset, const std::vector<size_t>& indices,
                                const FuseParams& params, TsdfVolume& volume,
-                               const FuseObserver& observer) {
+                               const FuseObserver& observer, const FrameRelay* relay) {
   const DatasetInfo& info = dataset.info();
   VOXPLAN_RETURN_IF_ERROR(params.Validate());
   VOXPLAN_RETURN_IF_ERROR(volume.params().Validate());
@@ -167,6 +167,8 @@ Result<FuseReport> FuseDataset(const Dataset& dataset, const std::vector<size_t>
       VOXPLAN_RETURN_IF_ERROR(CountOverBudget(*stats, *frame, params, volume, observer, report));
       report.load_ms.push_back(load_ms);
       report.integrate_ms.push_back(integrate_ms);
+      report.collect_ms.push_back(stats->collect_ms);
+      report.update_ms.push_back(stats->update_ms);
       report.frame_ms.push_back(load_ms + integrate_ms);
       report.frames.push_back(
           {frame->index, frame->timestamp, *T_W_C, frame->depth_path, frame->color_path});
@@ -187,12 +189,23 @@ Result<FuseReport> FuseDataset(const Dataset& dataset, const std::vector<size_t>
     std::optional<Result<Frame>> frame;
     double load_ms = 0.0;
   };
-  std::vector<Loaded> loaded(params.prefetch + 1);
+  const bool receiving = relay && relay->receive;  // frames come from another rank
+  std::vector<Loaded> loaded((receiving ? 0 : params.prefetch) + 1);
+  const auto count_skips = [&] {
+    report.skipped_no_pose = pose_skips.none.count();
+    report.skipped_bad_pose = pose_skips.bad.count();
+    report.skipped_pose_gap = pose_skips.gap.count();
+    report.first_frames_median_depth_m = depth_check.median_m();
+    report.suggested_depth_scale = depth_check.suggested_scale();
+    report.skipped_no_depth = no_depth.count();
+    report.frames_lost = lost.count();
+  };
   Status end = Status::Ok();  // what stopped the run early
   const Stopwatch loop_clock;
   ProduceAhead(
-      indices.size(), params.prefetch,
+      indices.size(), receiving ? 0 : params.prefetch,
       [&](size_t k) {
+        if (receiving) return;
         Loaded& slot = loaded[k % loaded.size()];
         slot.frame.reset();
         const Stopwatch load_clock;
@@ -200,14 +213,35 @@ Result<FuseReport> FuseDataset(const Dataset& dataset, const std::vector<size_t>
         slot.load_ms = load_clock.ElapsedMs();
       },
       [&](size_t k) {
-        if (observer.stop_requested && observer.stop_requested()) {
+        Loaded& slot = loaded[k % loaded.size()];
+        if (receiving) {
+          const Stopwatch receive_clock;
+          slot.frame.emplace(relay->receive());
+          slot.load_ms = receive_clock.ElapsedMs();
+          if (!slot.frame->ok() && slot.frame->status().code() == StatusCode::kCancelled) {
+            end = slot.frame->status();
+            return false;
+          }
+        } else if (observer.stop_requested && observer.stop_requested()) {
           end = Cancelled("stopped before frame " + std::to_string(indices[k]) + " (" +
                           std::to_string(k) + " of " + std::to_string(indices.size()) +
                           " selected frames done)");
+          if (relay && relay->send) {
+            if (Status s = relay->send(end); !s.ok()) end = s;
+          }
           return false;
+        } else if (relay && relay->send) {
+          if (Status s = relay->send(*slot.frame); !s.ok()) {
+            end = s;
+            return false;
+          }
         }
-        Loaded& slot = loaded[k % loaded.size()];
         end = fuse_frame(k, *slot.frame, slot.load_ms);
+        if (relay && relay->agree) end = relay->agree(end);
+        if (end.ok() && relay && relay->frame_done) {
+          count_skips();
+          end = relay->frame_done(k + 1, report);
+        }
         return end.ok();
       });
   if (!end.ok()) return end;
@@ -216,13 +250,7 @@ Result<FuseReport> FuseDataset(const Dataset& dataset, const std::vector<size_t>
   pose_skips.Finish();
   lost.Finish();
   no_depth.Finish();
-  report.skipped_no_pose = pose_skips.none.count();
-  report.skipped_bad_pose = pose_skips.bad.count();
-  report.skipped_pose_gap = pose_skips.gap.count();
-  report.first_frames_median_depth_m = depth_check.median_m();
-  report.suggested_depth_scale = depth_check.suggested_scale();
-  report.skipped_no_depth = no_depth.count();
-  report.frames_lost = lost.count();
+  count_skips();
   return report;
 }
 

@@ -77,6 +77,9 @@ struct FuseReport {
   size_t blocks_refused = 0, frames_over_budget = 0;
   // Per integrated frame: decoding, integration, their sum; per tracked frame: tracking.
   std::vector<double> load_ms, integrate_ms, frame_ms, track_ms;
+  // Per integrated frame, within integrate_ms: finding the band's blocks (a split map repeats it
+  // on every rank) and updating them (split between ranks).
+  std::vector<double> collect_ms, update_ms;
   double loop_s = 0.0;  // the whole loop, skipped frames included
 };
 
@@ -91,6 +94,23 @@ struct FuseObserver {
   std::function<bool()> stop_requested;
 };
 
+// A run split over ranks (distributed/sharded_fuse.h): frames travel from the rank that reads
+// the dataset to the others, and all ranks move from frame to frame together. Each hook is
+// called on the fusing thread, in frame order.
+struct FrameRelay {
+  // The reading rank: each selected frame as loaded, or the status that ends the run there
+  // (a stop request), before it is fused.
+  std::function<Status(const Result<Frame>& frame)> send;
+  // The other ranks: replaces loading (the dataset is not read there).
+  std::function<Result<Frame>()> receive;
+  // After each selected frame: every rank's status of that frame in, the first failure (or ok)
+  // out, the same on every rank.
+  std::function<Status(const Status& local)> agree;
+  // After `done` selected frames, agreed: the report so far (counts up to date), e.g. to write
+  // a checkpoint every few frames.
+  std::function<Status(size_t done, const FuseReport& so_far)> frame_done;
+};
+
 // Fuses dataset frames `indices` (in that order) into `volume`. Fails, naming the frame and its
 // file, when a frame cannot be loaded, integrated or tracked; invalid params (Validate(), the
 // volume's too) and a camera outside core/bounds.h's intrinsics ranges are refused before any
@@ -98,6 +118,7 @@ struct FuseObserver {
 // empty report (no frame integrated) is not a failure: the caller decides.
 Result<FuseReport> FuseDataset(const Dataset& dataset, const std::vector<size_t>& indices,
                                const FuseParams& params, TsdfVolume& volume,
-                               const FuseObserver& observer = {});
+                               const FuseObserver& observer = {},
+                               const FrameRelay* relay = nullptr);
 
 }  // namespace voxplan

@@ -10,11 +10,22 @@
 
 namespace voxplan {
 
+WorldUp FusedWorldUp(const DatasetInfo& info, const FuseReport& report, bool tracked) {
+  if (!tracked) return info.up;
+  WorldUpEstimator votes(info.camera.fy);
+  for (const FusedFrame& f : report.frames) votes.Add(f.T_W_C.linear().cast<double>());
+  return votes.Result().up;
+}
+
 Result<FuseOutputs> WriteFuseOutputs(const FuseOutputPaths& paths, const TsdfVolume& volume,
                                      const FuseReport& report, const MeshParams& mesh_params,
-                                     const FrameListParams& list) {
+                                     const FrameListParams& list, const Mesh* meshed,
+                                     double meshed_ms) {
   FuseOutputs out;
-  if (!paths.mesh.empty() || !paths.points.empty()) {
+  if (meshed) {
+    out.mesh = *meshed;
+    out.mesh_ms = meshed_ms;
+  } else if (!paths.mesh.empty() || !paths.points.empty()) {
     const Stopwatch mesh_clock;
     out.mesh = ExtractMesh(volume, mesh_params);
     out.mesh_ms = mesh_clock.ElapsedMs();
@@ -26,7 +37,7 @@ Result<FuseOutputs> WriteFuseOutputs(const FuseOutputPaths& paths, const TsdfVol
     if (Status s = WritePointCloudPly(out.mesh, paths.points); !s.ok()) return s;
   }
   if (!paths.map.empty()) {
-    if (Status s = SaveMap(volume, paths.map); !s.ok()) return s.Naming(paths.map);
+    if (Status s = SaveMap(volume, paths.map, paths.map_up); !s.ok()) return s.Naming(paths.map);
   }
   if (!paths.trajectory.empty()) {
     std::vector<double> timestamps_s;

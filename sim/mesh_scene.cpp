@@ -9,6 +9,7 @@
 
 #include "io/map_io.h"
 #include "io/mesh_io.h"
+#include "io/sharded_map.h"
 
 namespace voxplan {
 
@@ -83,7 +84,7 @@ Result<std::unique_ptr<SurfaceScene>> LoadSurfaceScene(const std::string& path,
                                                        const MapSceneParams& map_params,
                                                        const DollhouseParams& dollhouse) {
   if (IsMapPath(path)) {
-    Result<TsdfVolume> volume = LoadMap(path);
+    Result<TsdfVolume> volume = LoadAnyMap(path);  // plain or sharded (io/sharded_map.h)
     if (!volume.ok()) return volume.status();
     if (volume->num_blocks() == 0) return InvalidArgument("the map holds no blocks: " + path);
     return std::unique_ptr<SurfaceScene>(new MapScene(std::move(*volume), map_params));

@@ -17,6 +17,8 @@ RenderedDataset::RenderedDataset(const MeshRaycaster& raycaster, const PinholeCa
   info_.has_color = true;
   info_.intrinsics_source = "simulated";
   info_.pose_source = "simulated";
+  info_.up = WorldUp::kPlusZ;  // sim worlds are z-up metres
+  info_.up_source = "sim convention (worlds are z-up)";
 }
 
 Result<Frame> RenderedDataset::Load(size_t i) const {

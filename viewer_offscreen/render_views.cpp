@@ -26,16 +26,31 @@ Status RenderViewsParams::Validate() const {
     return InvalidArgument("up axis must be a finite non-zero vector");
   if (T_W_C && !T_W_C->matrix().allFinite())
     return InvalidArgument("render pose has NaN or infinite values");
+  for (size_t k = 0; k < poses.size(); ++k)
+    if (!poses[k].matrix().allFinite())
+      return InvalidArgument("render pose " + std::to_string(k) + " has NaN or infinite values");
+  if (camera) VOXPLAN_RETURN_IF_ERROR(bounds::CheckIntrinsics(*camera));
   return Status::Ok();
 }
 
 namespace {
 
+// `camera` at a tenth of its size (at least 16 x 12 pixels), for previews.
+PinholeCamera SmallCamera(const PinholeCamera& camera) {
+  PinholeCamera small = camera;
+  small.width = std::max(16, camera.width / 10);
+  small.height = std::max(12, camera.height / 10);
+  const float sx = float(small.width) / float(camera.width),
+              sy = float(small.height) / float(camera.height);
+  small.fx *= sx, small.cx = (camera.cx + 0.5f) * sx - 0.5f;
+  small.fy *= sy, small.cy = (camera.cy + 0.5f) * sy - 0.5f;
+  return small;
+}
+
 // The mean share of pixels on a surface over an orbit's views, rendered at a tenth of the size.
 double PreviewHits(const SurfaceScene& scene, const RenderViewsParams& params,
-                   const OrbitFraming& framing) {
-  const PinholeCamera small = CameraFromFov(std::max(16, params.width / 10),
-                                            std::max(12, params.height / 10), params.fov_deg);
+                   const PinholeCamera& camera, const OrbitFraming& framing) {
+  const PinholeCamera small = SmallCamera(camera);
   const std::vector<Pose3f> poses = OrbitPoses(framing.centre_W, framing.radius_m, framing.height_m,
                                                std::max(params.orbit_views, 1), params.up_W);
   double sum = 0.0;
@@ -50,28 +65,47 @@ double PreviewHits(const SurfaceScene& scene, const RenderViewsParams& params,
 
 }  // namespace
 
+PinholeCamera UprightCamera(const PinholeCamera& camera, const std::vector<Pose3f>& T_W_C,
+                            const Eigen::Vector3f& up_W, bool* flipped) {
+  if (flipped) *flipped = false;
+  if (!(camera.fy < 0.0f)) return camera;
+  // Rows run along -y of the camera in the image's upward direction for fy > 0, along +y here.
+  double top_along_up = 0.0;
+  for (const Pose3f& pose : T_W_C) top_along_up += double(pose.linear().col(1).dot(up_W));
+  if (top_along_up >= 0.0) return camera;
+  PinholeCamera upright = camera;
+  upright.fy = -camera.fy;
+  upright.cy = float(camera.height - 1) - camera.cy;
+  if (flipped) *flipped = true;
+  return upright;
+}
+
 Result<RenderedViews> RenderViews(const SurfaceScene& scene, const RenderViewsParams& params) {
   VOXPLAN_RETURN_IF_ERROR(params.Validate());
   RenderedViews views;
-  const PinholeCamera camera = CameraFromFov(params.width, params.height, params.fov_deg);
+  PinholeCamera camera =
+      params.camera ? *params.camera : CameraFromFov(params.width, params.height, params.fov_deg);
   views.bounds_W = scene.Bounds();
   OrbitFraming& framing = views.framing;
   framing = FrameBox(views.bounds_W, camera, params.orbit_elevation_deg);
   if (params.orbit_radius_m) framing.radius_m = *params.orbit_radius_m;
   if (params.orbit_height_m) {
     framing.height_m = *params.orbit_height_m;
-  } else if (params.choose_side && !params.T_W_C) {
+  } else if (params.choose_side && !params.T_W_C && params.poses.empty()) {
     OrbitFraming below = framing;
     below.height_m = -framing.height_m;
     // Below only when it sees clearly more: from above is how rooms are drawn.
-    if (PreviewHits(scene, params, below) > 1.5 * PreviewHits(scene, params, framing)) {
+    if (PreviewHits(scene, params, camera, below) >
+        1.5 * PreviewHits(scene, params, camera, framing)) {
       framing = below;
       views.from_below = true;
     }
   }
   framing.distance_m = std::hypot(framing.radius_m, framing.height_m);
   ShadeParams shade;
-  if (params.T_W_C) {
+  if (!params.poses.empty()) {
+    views.T_W_C = params.poses;  // depth range: per image
+  } else if (params.T_W_C) {
     views.T_W_C.push_back(*params.T_W_C);  // depth range: per image
   } else {
     views.T_W_C = OrbitPoses(framing.centre_W, framing.radius_m, framing.height_m,
@@ -81,6 +115,8 @@ Result<RenderedViews> RenderViews(const SurfaceScene& scene, const RenderViewsPa
     shade.depth_far_m = framing.distance_m + framing.bound_radius_m;
   }
 
+  camera = UprightCamera(camera, views.T_W_C, params.up_W, &views.rows_flipped);
+  views.camera = camera;
   double hit_fraction_sum = 0.0;
   for (const Pose3f& T_W_C : views.T_W_C) {
     if (params.stop_requested && params.stop_requested())

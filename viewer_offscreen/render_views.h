@@ -1,6 +1,7 @@
 #pragma once
-// Shaded views of a SurfaceScene: one from a given pose or a turntable framed on its bounds,
-// all kept in memory so a caller writes files only once every view has rendered.
+// Shaded views of a SurfaceScene: from given poses (one, or a dataset's frames) or a turntable
+// framed on its bounds, all kept in memory so a caller writes files only once every view has
+// rendered. Pictures are upright for a y-flipped camera too (UprightCamera).
 #include <Eigen/Geometry>
 #include <functional>
 #include <optional>
@@ -19,11 +20,17 @@ struct RenderViewsParams {
   int width = 640;
   int height = 480;
   float fov_deg = 60.0f;  // horizontal
+  // The views' camera, e.g. a dataset's (its size too; fy may be negative); unset: width x
+  // height pixels with the horizontal fov_deg.
+  std::optional<PinholeCamera> camera;
   ShadeMode mode = ShadeMode::kShaded;
   // One view from here (its depth colour range from the image); unset: an orbit.
   std::optional<Pose3f> T_W_C;
-  int orbit_views = 1;  // 0 renders one view too
-  Eigen::Vector3f up_W = Eigen::Vector3f::UnitZ();
+  // One view from each of these (a dataset's frames), each with its own depth colour range;
+  // when not empty, instead of T_W_C and the orbit.
+  std::vector<Pose3f> poses;
+  int orbit_views = 1;                              // 0 renders one view too
+  Eigen::Vector3f up_W = Eigen::Vector3f::UnitZ();  // the orbit's axis; upright pictures' up
   std::optional<float> orbit_radius_m;  // across the up axis; unset: framed on the bounds
   std::optional<float> orbit_height_m;  // along the up axis; unset: framed on the bounds
   float orbit_elevation_deg = 35.0f;    // of the framing
@@ -44,9 +51,23 @@ struct RenderedViews {
   OrbitFraming framing;       // the orbit (its centre is reported with a pose too)
   std::vector<Pose3f> T_W_C;  // one per image
   std::vector<ColorImage> images;
+  PinholeCamera camera;       // what they were rendered with (UprightCamera's)
+  bool rows_flipped = false;  // a y-flipped camera rendered with |fy| (UprightCamera)
   double hit_fraction = 0.0;  // mean over the views of the share of pixels on a surface
   bool from_below = false;    // choose_side put the orbit below the centre
 };
+
+// The camera that renders `camera`'s views from `T_W_C` upright, up along `up_W`. A camera with a
+// negative fy (a y-flipped one, ICL-NUIM's) lists its rows bottom-up: its pictures stay as they
+// are when their top rows look up on average over the views (a render at such a dataset's poses
+// is then its frames, pixel for pixel), and otherwise (an orbit's poses, built for OpenCV's
+// y-down image; a y-flipped dataset of an upright world) it becomes the camera with |fy| and
+// the principal point mirrored (cy -> height - 1 - cy), whose image is the y-flipped one with its
+// rows flipped. That is one ray cast per view rather than a flip of the shaded picture, so depth,
+// vertices, normals, colour and the shading's unprojection stay on one pixel grid. A camera with
+// fy > 0 is returned as it is. *flipped, when given, says whether it changed.
+PinholeCamera UprightCamera(const PinholeCamera& camera, const std::vector<Pose3f>& T_W_C,
+                            const Eigen::Vector3f& up_W, bool* flipped = nullptr);
 
 // Renders and shades every view; fails when the params are invalid, when shading refuses an
 // image or on a stop request.

@@ -37,6 +37,7 @@ struct Command {
 };
 
 Command AddFuseCommand(CLI::App& app);
+Command AddFarmCommand(CLI::App& app);
 Command AddMeshCommand(CLI::App& app);
 Command AddInfoCommand(CLI::App& app);
 Command AddEvalCommand(CLI::App& app);

@@ -20,12 +20,18 @@ std::vector<std::pair<std::string, std::vector<std::string>>> HelpExamples() {
       {"fuse",
        {"voxplan fuse " + kitchen + " --frames 200 --map out/kitchen.vpmap --mesh out/kitchen.ply",
         "voxplan fuse " + icl + " --voxel-size 0.02 --trunc 0.08 --track --trajectory " +
-            "out/icl_track.txt --mesh out/icl.ply"}},
+            "out/icl_track.txt --mesh out/icl.ply",
+        "mpirun -n 4 voxplan fuse " + kitchen +
+            " --voxel-size 0.005 --map out/kitchen5.vpmap --checkpoint-every 50 --mesh "
+            "out/kitchen5.ply"}},
+      {"farm", {"mpirun -n 4 voxplan farm out/suite_tasks.txt --stats out/farm.json"}},
       {"mesh", {"voxplan mesh out/kitchen.vpmap --out out/kitchen.glb --min-weight 2"}},
       {"info", {"voxplan info " + kitchen, "voxplan info out/kitchen.vpmap"}},
       {"render",
        {"voxplan render out/kitchen.vpmap --orbit 8 --out out/orbit",
-        "voxplan render out/kitchen.ply --mode normals --size 1280x960 --out out/view"}},
+        "voxplan render out/kitchen.ply --mode normals --size 1280x960 --out out/view",
+        "voxplan render out/kitchen.vpmap --dataset " + kitchen +
+            " --frames 3 --stride 60 --out out/at_frames"}},
       {"eval mesh",
        {"voxplan eval mesh out/replica.ply " + D("scenes/replica_office0/office0_mesh.ply")}},
       {"eval trajectory",

@@ -114,7 +114,8 @@ int RunDemo(const DemoOptions& o) {
   if (mesh.empty()) return Fail("the demo produced an empty mesh");
   if (Status s = WriteMesh(mesh, mesh_path); !s.ok()) return Fail(MessageNaming(s, mesh_path));
   if (Status s = WriteMesh(room, gt_path); !s.ok()) return Fail(MessageNaming(s, gt_path));
-  if (Status s = SaveMap(volume, map_path); !s.ok()) return Fail(MessageNaming(s, map_path));
+  if (Status s = SaveMap(volume, map_path, frames.info().up); !s.ok())
+    return Fail(MessageNaming(s, map_path));
 
   MeshEvalParams eval_params;
   eval_params.threshold_m = float(kThresholdVoxels * o.voxel_size_m);

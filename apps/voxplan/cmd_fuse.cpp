@@ -1,4 +1,6 @@
 // voxplan fuse: dataset -> TSDF volume -> mesh / map / stats.
+#include "apps/voxplan/cmd_fuse.h"
+
 #include <algorithm>
 #include <filesystem>
 #include <iostream>
@@ -27,32 +29,11 @@ namespace {
 
 namespace fs = std::filesystem;
 
-const std::map<std::string, Weighting> kWeightings = {{"constant", Weighting::kConstant},
-                                                      {"depth", Weighting::kDepthDependent}};
-
-struct FuseOptions {
-  DatasetInput in;
-  double voxel_size_m = 0.01;
-  double trunc_m = 0.04;
-  int threads = 0;
-  std::string intrinsics;
-  double depth_scale = 0.0;
-  std::string weighting = "constant";
-  std::string kernel = "auto";
-  double max_weight = 64.0;
-  double mesh_min_weight = 0.5;
-  std::string mesh_path, map_path, stats_path, frame_list_path, trajectory_path;
-  std::string points_path, octomap_path;
-  bool track = false;
-  double photometric_weight = 0.0;
-  MemoryBudgetOptions memory;
-  double max_pose_gap_s = 0.1;
-  size_t prefetch = FuseParams::kDefaultPrefetch;
-};
-
 nlohmann::json OrNull(const std::string& path) {
   return path.empty() ? nlohmann::json(nullptr) : nlohmann::json(path);
 }
+
+}  // namespace
 
 // The stats object: the same on the last stdout line and in --stats.
 nlohmann::json FuseStats(const FuseOptions& o, const DatasetInfo& info,
@@ -98,6 +79,10 @@ nlohmann::json FuseStats(const FuseOptions& o, const DatasetInfo& info,
   j["integrate_ms_median"] = RoundTo(integrate_t.median, 3);
   j["integrate_ms_p90"] = RoundTo(integrate_t.p90, 3);
   j["integrate_ms_mean"] = RoundTo(integrate_t.mean, 3);
+  // Within integration: finding the band's blocks and updating them (a split map repeats the
+  // first on every rank and splits the second).
+  j["collect_ms_median"] = RoundTo(Summarize(report.collect_ms).median, 3);
+  j["update_ms_median"] = RoundTo(Summarize(report.update_ms).median, 3);
   j["load_ms_median"] = RoundTo(load_t.median, 3);
   j["load_ms_p90"] = RoundTo(load_t.p90, 3);
   j["frame_ms_median"] = RoundTo(frame_t.median, 3);
@@ -123,6 +108,27 @@ nlohmann::json FuseStats(const FuseOptions& o, const DatasetInfo& info,
   return j;
 }
 
+FuseParams FuseParamsOf(const FuseOptions& o) {
+  FuseParams fuse;
+  IntegrateParams& params = fuse.integrate;
+  params.min_depth_m = float(o.in.min_depth_m);
+  params.max_depth_m = float(o.in.max_depth_m);
+  params.max_weight = float(o.max_weight);
+  params.weighting = o.weighting == "depth" ? Weighting::kDepthDependent : Weighting::kConstant;
+  params.kernel = kIntegrationKernels.at(o.kernel);
+  fuse.track = o.track;
+  fuse.prefetch = o.prefetch;
+  fuse.on_memory_limit = MemoryLimitAction(o.memory);
+  fuse.tracking.photometric_weight = float(o.photometric_weight);
+  fuse.tracking.raycast.max_depth_m = float(o.in.max_depth_m);
+  fuse.tracking.raycast.min_depth_m = float(o.in.min_depth_m);
+  return fuse;
+}
+
+VolumeParams VolumeParamsOf(const FuseOptions& o) {
+  return {float(o.voxel_size_m), float(o.trunc_m), MemoryBudgetBytes(o.memory)};
+}
+
 // No output may be another output or one of the dataset's files.
 int RefuseCollisions(const FuseOptions& o, const Dataset& dataset) {
   std::vector<PathUse> inputs;
@@ -137,10 +143,18 @@ int RefuseCollisions(const FuseOptions& o, const Dataset& dataset) {
                               inputs);
 }
 
+namespace {
+
 int RunFuse(const FuseOptions& o) {
   // Everything the arguments alone can refuse is refused before the dataset is read.
   if (std::string why = CheckVoxelAndTrunc(o.voxel_size_m, o.trunc_m); !why.empty())
     return Fail(why, kExitUsage);
+  if ((o.checkpoint_every > 0 || o.resume) && o.map_path.empty())
+    return Fail("--checkpoint-every and --resume need --map (the checkpoint is the map)",
+                kExitUsage);
+  Result<std::unique_ptr<Communicator>> world = WorldCommunicator();
+  if (!world.ok()) return Fail(world.status().message());
+  if ((*world)->size() > 1 || o.checkpoint_every > 0 || o.resume) return RunFuseSharded(o, **world);
   DatasetOptions dataset_options;
   if (!o.intrinsics.empty()) {
     Result<PinholeCamera> camera = ParseIntrinsics(o.intrinsics);
@@ -158,14 +172,9 @@ int RunFuse(const FuseOptions& o) {
   const std::vector<size_t>& indices = opened.indices;
   if (int code = RefuseCollisions(o, dataset); code != kExitOk) return code;
 
-  IntegrateParams params;
-  params.min_depth_m = float(o.in.min_depth_m);
-  params.max_depth_m = float(o.in.max_depth_m);
-  params.max_weight = float(o.max_weight);
-  params.weighting = kWeightings.at(o.weighting);
-  params.kernel = kIntegrationKernels.at(o.kernel);
-  TsdfVolume volume(
-      VolumeParams{float(o.voxel_size_m), float(o.trunc_m), MemoryBudgetBytes(o.memory)});
+  const FuseParams fuse = FuseParamsOf(o);
+  const IntegrateParams& params = fuse.integrate;
+  TsdfVolume volume(VolumeParamsOf(o));
 
   std::cerr << "fuse: " << info.root << " (" << DatasetFormatName(info.format) << "), "
             << indices.size() << " of " << info.num_frames << " frames, voxel " << o.voxel_size_m
@@ -173,14 +182,6 @@ int RunFuse(const FuseOptions& o) {
             << KernelName(ResolveKernel(params.kernel)) << ", memory budget "
             << Mib(volume.params().max_memory_bytes) << " MiB" << std::endl;
 
-  FuseParams fuse;
-  fuse.integrate = params;
-  fuse.track = o.track;
-  fuse.prefetch = o.prefetch;
-  fuse.on_memory_limit = MemoryLimitAction(o.memory);
-  fuse.tracking.photometric_weight = float(o.photometric_weight);
-  fuse.tracking.raycast.max_depth_m = float(o.in.max_depth_m);
-  fuse.tracking.raycast.min_depth_m = float(o.in.min_depth_m);
   Progress progress("fuse", indices.size());
   FuseObserver observer;
   observer.progress = [&](size_t done, size_t) { progress.Update(done); };
@@ -203,9 +204,10 @@ int RunFuse(const FuseOptions& o) {
   const FrameListParams list{info.camera, info.depth_scale, o.voxel_size_m,
                              o.trunc_m,   o.in.min_depth_m, o.in.max_depth_m};
   OutputTransaction written;  // every output lands, or none
-  Result<FuseOutputs> outputs = WriteFuseOutputs(
-      {o.mesh_path, o.map_path, o.trajectory_path, o.frame_list_path, o.points_path}, volume,
-      report, mesh_params, list);
+  FuseOutputPaths paths{o.mesh_path, o.map_path, o.trajectory_path, o.frame_list_path,
+                        o.points_path};
+  paths.map_up = FusedWorldUp(info, report, o.track);
+  Result<FuseOutputs> outputs = WriteFuseOutputs(paths, volume, report, mesh_params, list);
   if (!outputs.ok()) return Fail(outputs.status().message());
   const Mesh& mesh = outputs->mesh;
   // The occupancy as an OctoMap tree (planning/octomap_export.h), staged with the rest.
@@ -215,8 +217,12 @@ int RunFuse(const FuseOptions& o) {
     if (!exported.ok()) return Fail(MessageNaming(exported.status(), o.octomap_path));
     octomap = *exported;
   }
-  const nlohmann::json j =
-      FuseStats(o, info, params, report, volume, mesh, outputs->mesh_ms, octomap);
+  nlohmann::json j = FuseStats(o, info, params, report, volume, mesh, outputs->mesh_ms, octomap);
+  // The world's up axis the map records (render orbits about it), and where it came from.
+  j["up"] = WorldUpName(paths.map_up);
+  j["up_source"] = !o.track                            ? info.up_source
+                   : paths.map_up == WorldUp::kUnknown ? "unknown: the tracked poses do not tell"
+                                                       : "estimated from the tracked poses";
   const size_t integrated = report.frames.size();
   if (!o.stats_path.empty()) {
     if (Status s = WriteJsonFile(j, o.stats_path); !s.ok()) {
@@ -238,7 +244,8 @@ int RunFuse(const FuseOptions& o) {
     std::cerr << "mesh: " << o.mesh_path << " (" << mesh.num_vertices() << " vertices, "
               << mesh.num_triangles() << " triangles, " << j["mesh_ms"] << " ms)\n";
   }
-  if (!o.map_path.empty()) std::cerr << "map file: " << o.map_path << "\n";
+  if (!o.map_path.empty())
+    std::cerr << "map file: " << o.map_path << " (up " << WorldUpName(paths.map_up) << ")\n";
   if (!o.points_path.empty())
     std::cerr << "points: " << o.points_path << " (" << mesh.num_vertices() << " points)\n";
   if (octomap) {
@@ -309,6 +316,13 @@ Command AddFuseCommand(CLI::App& app) {
   sub->add_option("--frame-list", o->frame_list_path,
                   "Write the integrated frames (paths, poses, intrinsics) as JSON")
       ->check(OutputFileValidator());
+  sub->add_option("--checkpoint-every", o->checkpoint_every,
+                  "Write --map as a checkpoint every N selected frames (a sharded map: a manifest "
+                  "and one shard per rank), so that --resume can continue a killed run")
+      ->check(CLI::Range(size_t(1), size_t(1) << 30));
+  sub->add_flag("--resume", o->resume,
+                "Continue the run whose checkpoint is --map (same dataset, frames and "
+                "parameters; any rank count)");
   sub->add_option("--prefetch", o->prefetch,
                   "Frames decoded ahead while one is fused (0: one after the other; same results)")
       ->check(CLI::Range(size_t(0), FuseParams::kMaxPrefetch))

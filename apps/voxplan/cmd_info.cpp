@@ -8,6 +8,7 @@
 #include "core/block.h"
 #include "io/dataset.h"
 #include "io/map_io.h"
+#include "io/sharded_map.h"
 
 namespace voxplan::cli {
 
@@ -44,6 +45,7 @@ int DatasetInfoCommand(const InfoOptions& o) {
                info.intrinsics_source.c_str());
   std::fprintf(stderr, "depth scale %g units per metre\n", info.depth_scale);
   std::fprintf(stderr, "poses       %s\n", info.pose_source.c_str());
+  std::fprintf(stderr, "up axis     %s (%s)\n", WorldUpName(info.up), info.up_source.c_str());
   if (info.frames_bad_pose > 0)
     std::fprintf(stderr,
                  "bad poses   %zu of %zu frames (not rigid, e.g. ScanNet's -inf: no pose)\n",
@@ -65,6 +67,8 @@ int DatasetInfoCommand(const InfoOptions& o) {
   j["intrinsics_source"] = info.intrinsics_source;
   j["depth_scale"] = info.depth_scale;
   j["pose_source"] = info.pose_source;
+  j["up"] = WorldUpName(info.up);
+  j["up_source"] = info.up_source;
   j["frames_bad_pose"] = info.frames_bad_pose;
   j["has_color"] = info.has_color;
   if (!info.streams.empty()) j["topics"] = info.streams;
@@ -73,7 +77,51 @@ int DatasetInfoCommand(const InfoOptions& o) {
   return kExitOk;
 }
 
+// A sharded map (io/sharded_map.h): its manifest, then the shards loaded as one map.
+int ShardedMapInfoCommand(const InfoOptions& o) {
+  Result<ShardManifest> manifest = ReadShardManifest(o.path);
+  if (!manifest.ok()) return Fail(MessageNaming(manifest.status(), o.path));
+  Result<TsdfVolume> volume = LoadShardedMap(o.path);
+  if (!volume.ok()) return Fail(MessageNaming(volume.status(), o.path));
+  uint64_t file_bytes = 0;
+  nlohmann::json shards = nlohmann::json::array();
+  for (const ShardManifest::Shard& s : manifest->shards) {
+    std::error_code ec;
+    const auto bytes = fs::file_size(ShardFilePath(o.path, s.file), ec);
+    file_bytes += ec ? 0 : uint64_t(bytes);
+    shards.push_back({{"file", s.file}, {"blocks", s.blocks}});
+  }
+  std::fprintf(stderr, "map         %s (sharded: manifest)\n", o.path.c_str());
+  std::fprintf(stderr, "shards      %u (owner %s)%s\n", manifest->ranks,
+               manifest->owner_function.c_str(),
+               manifest->complete ? "" : ", a checkpoint of an unfinished run");
+  std::fprintf(stderr, "voxel size  %g m\n", manifest->params.voxel_size_m);
+  std::fprintf(stderr, "truncation  %g m\n", manifest->params.trunc_m);
+  std::fprintf(stderr, "up axis     %s\n", WorldUpName(manifest->up));
+  std::fprintf(stderr, "blocks      %zu (%zu voxels)\n", volume->num_blocks(),
+               volume->num_voxels());
+  std::fprintf(stderr, "files       %.3f MiB in all\n", Mib(size_t(file_bytes)));
+  nlohmann::json j;
+  j["command"] = "info";
+  j["kind"] = "sharded_map";
+  j["path"] = o.path;
+  j["ranks"] = manifest->ranks;
+  j["complete"] = manifest->complete;
+  j["generation"] = manifest->generation;
+  j["owner_function"] = manifest->owner_function;
+  j["voxel_size_m"] = ShortestDouble(manifest->params.voxel_size_m);
+  j["trunc_m"] = ShortestDouble(manifest->params.trunc_m);
+  j["up"] = WorldUpName(manifest->up);
+  AddMapStats(j, *volume);
+  j["checksum"] = std::to_string(VolumeChecksum(*volume));
+  j["shards"] = shards;
+  j["file_bytes"] = file_bytes;
+  PrintJsonLine(j);
+  return kExitOk;
+}
+
 int MapInfoCommand(const InfoOptions& o) {
+  if (IsShardedMapFile(o.path)) return ShardedMapInfoCommand(o);
   Result<MapHeader> header = ReadMapHeader(o.path);
   if (!header.ok()) return Fail(MessageNaming(header.status(), o.path));
   Result<TsdfVolume> volume = LoadMap(o.path);
@@ -92,6 +140,8 @@ int MapInfoCommand(const InfoOptions& o) {
   std::fprintf(stderr, "version     %u\n", header->version);
   std::fprintf(stderr, "voxel size  %g m\n", header->params.voxel_size_m);
   std::fprintf(stderr, "truncation  %g m\n", header->params.trunc_m);
+  std::fprintf(stderr, "up axis     %s%s\n", WorldUpName(header->up),
+               header->up == WorldUp::kUnknown ? " (render takes +z)" : "");
   std::fprintf(stderr, "blocks      %llu (%zu voxels, %zu observed, %.1f%%)\n",
                (unsigned long long)header->num_blocks, volume->num_voxels(), observed,
                observed_percent);
@@ -107,8 +157,11 @@ int MapInfoCommand(const InfoOptions& o) {
   j["version"] = header->version;
   j["voxel_size_m"] = ShortestDouble(header->params.voxel_size_m);
   j["trunc_m"] = ShortestDouble(header->params.trunc_m);
+  j["up"] = WorldUpName(header->up);
   AddMapStats(j, *volume);
   j["observed_voxels"] = observed;
+  // Of the blocks alone (io/sharded_map.h): equal for equal maps, plain or sharded.
+  j["checksum"] = std::to_string(VolumeChecksum(*volume));
   j["memory_bytes"] = volume->MemoryBytes();
   j["file_bytes"] = ec ? 0 : size_t(file_bytes);
   PrintJsonLine(j);

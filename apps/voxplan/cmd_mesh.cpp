@@ -9,6 +9,7 @@
 #include "fusion/mesh_extract.h"
 #include "io/map_io.h"
 #include "io/mesh_io.h"
+#include "io/sharded_map.h"
 
 namespace voxplan::cli {
 
@@ -32,7 +33,7 @@ int RunMesh(const MeshOptions& o) {
     return code;
   ThreadLimit thread_limit(o.threads);
   const Stopwatch load_clock;
-  Result<TsdfVolume> volume = LoadMap(o.map_path);
+  Result<TsdfVolume> volume = LoadAnyMap(o.map_path);  // plain or sharded
   if (!volume.ok()) return Fail(MessageNaming(volume.status(), o.map_path));
   const double load_ms = load_clock.ElapsedMs();
 

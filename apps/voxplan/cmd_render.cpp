@@ -1,4 +1,5 @@
-// voxplan render: map or mesh -> shaded PNG views (a pose, or a turntable around the centre).
+// voxplan render: map or mesh -> shaded PNG views (a pose, a dataset's frames, or a turntable
+// around the centre), about the map's recorded up axis unless --up says otherwise.
 #include <unistd.h>
 
 #include <filesystem>
@@ -12,9 +13,12 @@
 #include "apps/voxplan/signals.h"
 #include "core/bounds.h"
 #include "core/parallel.h"
+#include "io/dataset.h"
 #include "io/image_io.h"
 #include "io/map_io.h"
+#include "io/sharded_map.h"
 #include "io/mesh_io.h"
+#include "io/world_up.h"
 #include "sim/mesh_scene.h"
 #include "viewer_offscreen/render_views.h"
 #include "viewer_offscreen/shading.h"
@@ -35,7 +39,9 @@ struct RenderOptions {
   double fov_deg = 60.0;
   std::string out_dir;
   double min_weight = 0.5;
-  std::string up = "z";       // the scene's up axis, for orbits (ICL-NUIM maps are Y-up)
+  std::string up = "auto";    // the scene's up axis; auto: the map's recorded one, else z
+  std::string intrinsics;     // "fx,fy,cx,cy" of the views' camera (size from --size)
+  DatasetInput dataset;       // --dataset: views at its frames' poses, with its camera
   double orbit_radius_m = 0;  // 0: from the bounds
   double orbit_height_m = 0;
   bool orbit_height_set = false;
@@ -75,6 +81,56 @@ nlohmann::json Json(const Eigen::Vector3f& v) {
   return {RoundTo(v.x(), 6), RoundTo(v.y(), 6), RoundTo(v.z(), 6)};
 }
 
+// The up axis of the views: --up, else (auto) the map's recorded one, else +z. `source` says
+// which: "--up", "map", or "default" (which a --dataset's own up axis then replaces).
+Eigen::Vector3f ViewsUp(const RenderOptions& o, std::string* source) {
+  if (o.up != "auto") {
+    *source = "--up";
+    return WorldUpOrZ(*ParseWorldUp(o.up));  // checked by the validator
+  }
+  *source = "default";
+  if (!IsMapPath(o.input)) return Eigen::Vector3f::UnitZ();
+  if (IsShardedMapFile(o.input)) {  // a sharded map's manifest records it (io/sharded_map.h)
+    const Result<ShardManifest> manifest = ReadShardManifest(o.input);
+    if (!manifest.ok() || manifest->up == WorldUp::kUnknown) return Eigen::Vector3f::UnitZ();
+    *source = "map";
+    return WorldUpOrZ(manifest->up);
+  }
+  // A header that does not read leaves the up at +z; loading the map reports the problem.
+  const Result<MapHeader> header = ReadMapHeader(o.input);
+  if (!header.ok() || header->up == WorldUp::kUnknown) return Eigen::Vector3f::UnitZ();
+  *source = "map";
+  return WorldUpOrZ(header->up);
+}
+
+// --dataset: the poses of the selected frames that have one, their indices, the camera, the
+// world's up axis and the dataset's files (no output may be one).
+struct DatasetViews {
+  std::vector<Pose3f> poses;
+  std::vector<size_t> frames;
+  PinholeCamera camera;
+  WorldUp up = WorldUp::kUnknown;
+  std::vector<std::string> files;
+};
+int LoadDatasetViews(const DatasetInput& in, DatasetViews* views) {
+  OpenedDataset opened;
+  if (int code = OpenDatasetInput(in, {}, &opened); code != kExitOk) return code;
+  views->files = opened.dataset->InputFiles();
+  views->camera = opened.dataset->info().camera;
+  views->up = opened.dataset->info().up;
+  for (size_t i : opened.indices) {
+    Result<Frame> frame = opened.dataset->Load(i);
+    if (!frame.ok()) return Fail(MessageNaming(frame.status(), in.dataset));
+    if (!frame->T_W_C) continue;  // ICL-NUIM's first frame, a gap in the ground truth
+    views->poses.push_back(Pose3f(frame->T_W_C->cast<float>()));
+    views->frames.push_back(i);
+  }
+  if (views->poses.empty())
+    return Fail("none of the " + std::to_string(opened.indices.size()) +
+                " selected frames has a pose: " + in.dataset);
+  return kExitOk;
+}
+
 int RunRender(const RenderOptions& o) {
   std::error_code ec;
   if (!fs::is_regular_file(o.input, ec)) return Fail("input file not found: " + o.input);
@@ -84,16 +140,45 @@ int RunRender(const RenderOptions& o) {
   params.fov_deg = float(o.fov_deg);
   if (o.orbit_radius_m > 0.0) params.orbit_radius_m = float(o.orbit_radius_m);
   if (o.orbit_height_set) params.orbit_height_m = float(o.orbit_height_m);
-  params.up_W = o.up == "y" ? Eigen::Vector3f::UnitY() : Eigen::Vector3f(Eigen::Vector3f::UnitZ());
+  std::string up_source;
+  params.up_W = ViewsUp(o, &up_source);
   if (!o.pose.empty()) params.T_W_C = *ParsePose(o.pose);  // checked by the validator
   params.orbit_views = o.orbit;
-  // The files it will write: none may be the input.
-  std::vector<PathUse> outputs;
-  for (int k = 0; k < (params.T_W_C ? 1 : std::max(o.orbit, 1)); ++k)
-    outputs.push_back({"--out", (fs::path(o.out_dir) / ViewFileName(size_t(k))).string()});
-  if (int code = RefusePathCollisions(outputs, {{"the input", o.input}}); code != kExitOk)
-    return code;
+  if (!o.intrinsics.empty()) {
+    Result<PinholeCamera> camera = ParseIntrinsics(o.intrinsics);
+    if (!camera.ok()) return Fail("--intrinsics: " + camera.status().message(), kExitUsage);
+    camera->width = params.width;
+    camera->height = params.height;
+    if (Status s = bounds::CheckIntrinsics(*camera); !s.ok())
+      return Fail("--intrinsics: " + s.message(), kExitUsage);
+    params.camera = *camera;
+  }
+  const bool at_dataset = !o.dataset.dataset.empty();
   ThreadLimit thread_limit(o.threads);
+  // The files it will write: none may be the input (nor, with --dataset, one of its files).
+  const auto view_files = [&](size_t n) {
+    std::vector<PathUse> outputs;
+    for (size_t k = 0; k < n; ++k)
+      outputs.push_back({"--out", (fs::path(o.out_dir) / ViewFileName(k)).string()});
+    return outputs;
+  };
+  DatasetViews dataset_views;
+  if (at_dataset) {
+    if (int code = LoadDatasetViews(o.dataset, &dataset_views); code != kExitOk) return code;
+    params.poses = dataset_views.poses;
+    params.camera = dataset_views.camera;
+    // A map that records no up axis (version 1) is in the dataset's world: take its up.
+    if (up_source == "default" && dataset_views.up != WorldUp::kUnknown) {
+      params.up_W = WorldUpOrZ(dataset_views.up);
+      up_source = "dataset";
+    }
+  }
+  const size_t num_views = at_dataset     ? params.poses.size()
+                           : params.T_W_C ? 1
+                                          : size_t(std::max(o.orbit, 1));
+  std::vector<PathUse> inputs = {{"the input", o.input}};
+  AddInputs(inputs, "the dataset", dataset_views.files);
+  if (int code = RefusePathCollisions(view_files(num_views), inputs); code != kExitOk) return code;
 
   const Stopwatch load_clock;
   MapSceneParams map_params;
@@ -101,7 +186,8 @@ int RunRender(const RenderOptions& o) {
   map_params.near_m = float(o.near_m);
   map_params.simd = o.kernel != "scalar";
   DollhouseParams dollhouse;
-  dollhouse.enabled = o.dollhouse == "on" || (o.dollhouse == "auto" && !params.T_W_C);
+  dollhouse.enabled =
+      o.dollhouse == "on" || (o.dollhouse == "auto" && !params.T_W_C && params.poses.empty());
   dollhouse.up_W = params.up_W;
   params.choose_side = dollhouse.enabled;
   Result<std::unique_ptr<SurfaceScene>> loaded = LoadSurfaceScene(o.input, map_params, dollhouse);
@@ -116,6 +202,12 @@ int RunRender(const RenderOptions& o) {
     return Interrupted(views.status().message() + "; nothing written");
   if (!views.ok()) return Fail("shading failed: " + views.status().message());
   const double render_ms = render_clock.ElapsedMs();
+  // A y-down camera whose top looks down: likely a pose of a y-flipped dataset (ICL-NUIM's).
+  if (params.T_W_C && views->camera.fy > 0.0f &&
+      -params.T_W_C->linear().col(1).dot(params.up_W.normalized()) < -0.5f)
+    Warn("the view is upside down about the up axis (" + up_source +
+         "); a pose of a y-flipped camera (ICL-NUIM's)? Give its --intrinsics (negative fy) or "
+         "render at --dataset");
 
   // Only now touch the disk: every image is in memory.
   const Stopwatch write_clock;
@@ -129,23 +221,31 @@ int RunRender(const RenderOptions& o) {
 
   for (const std::string& path : *written) std::cerr << "wrote " << path << "\n";
   std::cerr << "render: " << written->size() << " " << ShadeModeName(params.mode) << " view(s) of "
-            << o.input << " at " << params.width << "x" << params.height << " in "
+            << o.input << " at " << views->camera.width << "x" << views->camera.height << " in "
             << RoundTo(render_ms, 1) << " ms\n";
   nlohmann::json j;
   j["command"] = "render";
   j["input"] = o.input;
   j["input_kind"] = IsMapPath(o.input) ? "map" : "mesh";
   j["mode"] = ShadeModeName(params.mode);
-  j["width"] = params.width;
-  j["height"] = params.height;
+  j["width"] = views->camera.width;
+  j["height"] = views->camera.height;
   j["fov_deg"] = o.fov_deg;
+  j["camera"] = CameraJson(views->camera);  // as rendered (UprightCamera)
+  j["rows_flipped"] = views->rows_flipped;
+  j["up"] = Json(params.up_W);
+  j["up_source"] = up_source;
+  if (at_dataset) {
+    j["dataset"] = o.dataset.dataset;
+    j["dataset_frames"] = dataset_views.frames;
+  }
   j["views"] = written->size();
   j["out"] = o.out_dir;
   j["files"] = *written;
   j["bounds_min"] = Json(views->bounds_W.min());
   j["bounds_max"] = Json(views->bounds_W.max());
   j["centre"] = Json(views->framing.centre_W);
-  if (o.pose.empty()) {
+  if (o.pose.empty() && !at_dataset) {
     j["orbit_radius_m"] = RoundTo(views->framing.radius_m, 6);
     j["orbit_height_m"] = RoundTo(views->framing.height_m, 6);
   }
@@ -215,23 +315,56 @@ Command AddRenderCommand(CLI::App& app) {
       sub->add_option("--orbit", o->orbit, "Turntable of N views around the centre")
           ->check(IntInRange(1, 3600));
   pose->excludes(orbit);
+  CLI::Option* dataset =
+      sub->add_option("--dataset", o->dataset.dataset,
+                      "Render at this dataset's frames' poses with its camera and image size "
+                      "(folder, .sens or .bag)");
+  dataset->excludes(pose)->excludes(orbit);
+  sub->add_option("--format", o->dataset.format, "With --dataset: its format")
+      ->check(CLI::IsMember(
+          {"auto", "tum", "icl", "redwood", "7scenes", "3dmatch", "replica", "scannet", "rosbag"}))
+      ->capture_default_str()
+      ->needs(dataset);
+  AddTopicsOption(sub, o->dataset.topics);
+  sub->add_option("--frames", o->dataset.frames, "With --dataset: frames to render (0: all)")
+      ->check(FrameCount())
+      ->capture_default_str()
+      ->needs(dataset);
+  sub->add_option("--start", o->dataset.start, "With --dataset: first frame (0-based)")
+      ->check(IntInRange(0, bounds::kFramesMax))
+      ->capture_default_str()
+      ->needs(dataset);
+  sub->add_option("--stride", o->dataset.stride, "With --dataset: every K-th frame")
+      ->check(Stride())
+      ->capture_default_str()
+      ->needs(dataset);
+  CLI::Option* intrinsics =
+      sub->add_option("--intrinsics", o->intrinsics,
+                      "Camera fx,fy,cx,cy of the views (a dataset's, fy may be negative), at "
+                      "--size; default: from --fov-deg");
+  intrinsics->excludes(dataset);
   sub->add_option("--mode", o->mode, "Shading")
       ->check(CLI::IsMember({"shaded", "normals", "colour", "color", "depth"}))
       ->capture_default_str();
-  sub->add_option("--size", o->size, "Image size WxH")
+  sub->add_option("--size", o->size, "Image size WxH (with --dataset: the dataset's)")
       ->check(ParsedBy(&ParseSize, "WxH"))
-      ->capture_default_str();
+      ->capture_default_str()
+      ->excludes(dataset);
   sub->add_option("--fov-deg", o->fov_deg, "Horizontal field of view (degrees)")
       ->check(InRange(1.0, 179.0, "degrees"))
-      ->capture_default_str();
+      ->capture_default_str()
+      ->excludes(dataset)
+      ->excludes(intrinsics);
   sub->add_option("--out,-o", o->out_dir, "Output folder (created if missing)")
       ->required()
       ->check(OutputDirValidator());
   sub->add_option("--min-weight", o->min_weight, "Maps: voxels with less weight are unobserved")
       ->check(InRange(0.0, kMaxWeight))
       ->capture_default_str();
-  sub->add_option("--up", o->up, "Up axis of the scene, for orbits")
-      ->check(CLI::IsMember({"y", "z"}))
+  sub->add_option("--up", o->up,
+                  "Up axis of the scene, for orbits and upright pictures: auto (the map's "
+                  "recorded one, else the --dataset's, else z), x, y, z, -x, -y, -z")
+      ->check(CLI::IsMember({"auto", "x", "y", "z", "+x", "+y", "+z", "-x", "-y", "-z"}))
       ->capture_default_str();
   sub->add_option("--orbit-radius", o->orbit_radius_m,
                   "Orbit: distance from the centre across the up axis (m; default from bounds)")

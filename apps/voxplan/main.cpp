@@ -1,6 +1,7 @@
 // voxplan: one CLI, one subcommand per task. Each cmd_*.cpp parses its flags, calls the
 // libraries and prints; nothing here knows how fusion or I/O work.
 #include <CLI/CLI.hpp>
+#include <cstdlib>
 #include <exception>
 #include <iostream>
 #include <vector>
@@ -21,9 +22,9 @@ int main(int argc, char** argv) {
   });
 
   std::vector<Command> commands = {
-      AddFuseCommand(app),  AddMeshCommand(app), AddInfoCommand(app),
-      AddEvalCommand(app),  AddDemoCommand(app), AddRenderCommand(app),
-      AddBenchCommand(app), AddSimCommand(app),  AddExploreCommand(app)};
+      AddFuseCommand(app),    AddMeshCommand(app),   AddInfoCommand(app),  AddEvalCommand(app),
+      AddDemoCommand(app),    AddRenderCommand(app), AddBenchCommand(app), AddSimCommand(app),
+      AddExploreCommand(app), AddFarmCommand(app)};
   AddHelpExamples(app);
   try {
     app.parse(argc, argv);
@@ -38,6 +39,13 @@ int main(int argc, char** argv) {
     return kExitUsage;
   }
 
+  // Under mpirun every rank runs the command: only fuse and farm know how to share the work.
+  if (const char* ranks = std::getenv("OMPI_COMM_WORLD_SIZE"); ranks && std::atoi(ranks) > 1) {
+    const std::string name = app.get_subcommands().front()->get_name();
+    if (name != "fuse" && name != "farm")
+      return Fail("voxplan " + name + " runs in one process: only fuse and farm run under mpirun",
+                  kExitUsage);
+  }
   InstallSignalHandlers();
   try {
     return RunParsed(commands);

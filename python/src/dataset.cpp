@@ -468,7 +468,8 @@ std::unique_ptr<PyFuseResult> Fuse(const py::object& dataset_in, double voxel_si
     throw StatusError(Status(StatusCode::kInternal, "no frame was integrated (" +
                                                         std::to_string(indices.size()) +
                                                         " selected, all skipped): " + ds.path));
-  result->volume = WrapVolume(std::move(*volume), params);
+  result->volume =
+      WrapVolume(std::move(*volume), params, FusedWorldUp(info, result->report, fuse.track));
   return result;
 }
 
@@ -589,6 +590,12 @@ voxplan.open_dataset.
                              [](const PyDataset& d) { return d.dataset->info().intrinsics_source; })
       .def_property_readonly("pose_source",
                              [](const PyDataset& d) { return d.dataset->info().pose_source; })
+      .def_property_readonly(
+          "up", [](const PyDataset& d) { return std::string(WorldUpName(d.dataset->info().up)); },
+          "the world's up axis ('+y', '+z', ..., 'unknown'): the format's convention, else "
+          "estimated from the poses (up_source says which)")
+      .def_property_readonly("up_source",
+                             [](const PyDataset& d) { return d.dataset->info().up_source; })
       .def_property_readonly("warnings",
                              [](const PyDataset& d) { return d.dataset->info().warnings; })
       .def_property_readonly(
@@ -693,8 +700,9 @@ of `voxplan fuse`'s stats.
             const auto path = [](const py::object& p) {
               return p.is_none() ? std::string() : PathString(p);
             };
-            const FuseOutputPaths paths{path(mesh), path(map), path(trajectory), path(frame_list)};
             const PyVolume& v = r.volume.cast<const PyVolume&>();
+            FuseOutputPaths paths{path(mesh), path(map), path(trajectory), path(frame_list)};
+            paths.map_up = v.up;  // read under the GIL, as it is set
             auto out = std::make_unique<PyMesh>();
             {
               py::gil_scoped_release release;

@@ -226,9 +226,13 @@ std::unique_ptr<PyExploreResult> Explore(
   mesh->mesh = std::move(report->mesh);
   out->mesh = py::cast(std::move(mesh));
   ExploreResult& loop = report->loop;
-  out->volume = loop.volume ? WrapVolume(std::move(*loop.volume), IntegrateParams{}) : py::none();
-  out->recon_volume =
-      loop.recon_volume ? WrapVolume(std::move(*loop.recon_volume), IntegrateParams{}) : py::none();
+  // Explored worlds are sim's, z-up.
+  out->volume = loop.volume
+                    ? WrapVolume(std::move(*loop.volume), IntegrateParams{}, WorldUp::kPlusZ)
+                    : py::none();
+  out->recon_volume = loop.recon_volume ? WrapVolume(std::move(*loop.recon_volume),
+                                                     IntegrateParams{}, WorldUp::kPlusZ)
+                                        : py::none();
   out->out_dir = temporary ? py::object(py::none()) : py::object(py::str(run.out_dir));
   out->terminated = loop.terminated;
   out->done_reason = loop.done_reason;

@@ -8,17 +8,20 @@
 #include "core/raycast.h"
 #include "core/volume.h"
 #include "fusion/integrate.h"
+#include "io/world_up.h"
 #include "python/src/common.h"
 
 namespace voxplan::python {
 
-// voxplan.Volume: the TSDF volume and the integration parameters it is fused with. The lock
-// lets Python threads share a volume with the GIL released: integrate, clear and load take it
-// exclusively, every read shared.
+// voxplan.Volume: the TSDF volume, the integration parameters it is fused with and the world's
+// up axis its map file records. The lock lets Python threads share a volume with the GIL
+// released: integrate, clear and load take it exclusively, every read shared.
 struct PyVolume {
-  PyVolume(TsdfVolume v, const IntegrateParams& p) : volume(std::move(v)), integrate(p) {}
+  PyVolume(TsdfVolume v, const IntegrateParams& p, WorldUp u = WorldUp::kUnknown)
+      : volume(std::move(v)), integrate(p), up(u) {}
   TsdfVolume volume;
   IntegrateParams integrate;
+  WorldUp up = WorldUp::kUnknown;
   mutable std::shared_mutex mutex;
 };
 
@@ -37,8 +40,9 @@ void BindVolume(py::module_& m);   // Volume, Mesh, RaycastImages, read_mesh, ev
 void BindDataset(py::module_& m);  // Dataset, Frame, open_dataset, fuse, FuseResult
 void BindExplore(py::module_& m);  // explore, ExploreResult, planners
 
-// A Python Volume adopting `volume` (fuse's, explore's, a loaded map).
-py::object WrapVolume(TsdfVolume volume, const IntegrateParams& params);
+// A Python Volume adopting `volume` (fuse's, explore's, a loaded map) and its up axis.
+py::object WrapVolume(TsdfVolume volume, const IntegrateParams& params,
+                      WorldUp up = WorldUp::kUnknown);
 // "constant" / "depth"; "auto" / "scalar" / "simd": ValueError otherwise.
 Weighting ParseWeighting(const std::string& name);
 Kernel ParseKernel(const std::string& name);

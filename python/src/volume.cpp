@@ -16,6 +16,7 @@
 #include "eval/eval_mesh.h"
 #include "fusion/mesh_extract.h"
 #include "io/map_io.h"
+#include "io/sharded_map.h"
 #include "io/mesh_io.h"
 #include "python/src/objects.h"
 
@@ -193,8 +194,8 @@ const char* WeightingName(Weighting w) {
   return w == Weighting::kDepthDependent ? "depth" : "constant";
 }
 
-py::object WrapVolume(TsdfVolume volume, const IntegrateParams& params) {
-  return py::cast(std::make_unique<PyVolume>(std::move(volume), params));
+py::object WrapVolume(TsdfVolume volume, const IntegrateParams& params, WorldUp up) {
+  return py::cast(std::make_unique<PyVolume>(std::move(volume), params, up));
 }
 
 void BindVolume(py::module_& m) {
@@ -333,6 +334,12 @@ The defaults are `voxplan fuse`'s.)doc")
       .def_property_readonly("voxel_size",
                              [](const PyVolume& v) { return v.volume.voxel_size_m(); })
       .def_property_readonly("trunc", [](const PyVolume& v) { return v.volume.trunc_m(); })
+      .def_property(
+          "up", [](const PyVolume& v) { return std::string(WorldUpName(v.up)); },
+          [](PyVolume& v, const std::string& up) { v.up = ValueOrThrow(ParseWorldUp(up)); },
+          "The world's up axis the map file records: 'unknown' (read as +z), '+x', '-x', '+y', "
+          "'-y', '+z' or '-z' ('x', 'y', 'z' are accepted). fuse() sets it from the dataset "
+          "(Dataset.up), load() from the file; `voxplan render` orbits about it.")
       .def_property_readonly("max_memory",
                              [](const PyVolume& v) { return v.volume.params().max_memory_bytes; })
       .def_property(
@@ -537,28 +544,31 @@ seen from outside).)doc")
           "save",
           [](const PyVolume& self, const py::object& path) {
             const std::string p = PathString(path);
+            const WorldUp up = self.up;  // set under the GIL
             py::gil_scoped_release release;
             std::lock_guard write_lock(WriteMutex());
             std::shared_lock lock(self.mutex);
-            ThrowIfError(SaveMap(self.volume, p));
+            ThrowIfError(SaveMap(self.volume, p, up));
           },
           py::arg("path"),
-          "Writes the map (.vpmap: voxel size, truncation, the blocks in sorted order, a "
-          "checksum) through a temporary file renamed into place; the same bytes as `voxplan "
-          "fuse --map` for the same volume.")
+          "Writes the map (.vpmap: voxel size, truncation, the up axis Volume.up, the blocks in "
+          "sorted order, a checksum) through a temporary file renamed into place; the same bytes "
+          "as `voxplan fuse --map` for the same volume and up axis.")
       .def_static(
           "load",
           [](const py::object& path) {
             const std::string p = PathString(path);
             std::optional<TsdfVolume> volume;
+            WorldUp up = WorldUp::kUnknown;
             {
               py::gil_scoped_release release;
-              volume.emplace(ValueOrThrow(LoadMap(p)));
+              volume.emplace(ValueOrThrow(LoadAnyMap(p, &up)));  // plain or sharded
             }
-            return WrapVolume(std::move(*volume), IntegrateParams{});
+            return WrapVolume(std::move(*volume), IntegrateParams{}, up);
           },
           py::arg("path"),
-          "Reads a .vpmap map file (checked: magic, version, parameters, checksum); integration "
+          "Reads a .vpmap map file (checked: magic, version, parameters, checksum), version 1 "
+          "or 2; Volume.up is the recorded up axis ('unknown' for version 1); integration "
           "parameters start at their defaults. FileNotFoundError / ValueError name the file.")
       .def("__repr__", [](const PyVolume& v) {
         std::shared_lock lock(v.mutex);

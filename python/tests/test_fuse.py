@@ -45,6 +45,10 @@ def test_fuse_equals_the_cli(icl: Path, cli_outputs: Path, tmp_path: Path) -> No
                 "blocks", "voxels", "map_mb", "kernel", "threads", "depth_scale"):
         assert stats[key] == cli_stats[key], key
     assert result.frames == FRAMES - 1 and result.frames_skipped == 1  # frame id 1: no pose
+    # ICL-NUIM's world is y-up: the dataset says so, the map records it, as the CLI's does.
+    assert ds.up == "+y" and "ICL-NUIM" in ds.up_source
+    assert result.volume.up == "+y" and cli_stats["up"] == "+y"
+    assert voxplan.Volume.load(tmp_path / "py.vpmap").up == "+y"
     assert list(result.frame_indices) == list(range(1, FRAMES))
     assert result.poses.shape == (FRAMES - 1, 4, 4) and result.integrate_ms.shape == (FRAMES - 1,)
     # The volume is a Volume like any other: its mesh is the written one.
@@ -59,6 +63,7 @@ def test_python_frame_loop_equals_the_cli(icl: Path, cli_outputs: Path, tmp_path
     for frame in ds.frames(count=FRAMES):
         if frame.T_W_C is not None:
             volume.integrate(frame.depth, frame.color, frame.K, frame.T_W_C)
+    volume.up = ds.up  # what fuse records: the dataset's up axis
     volume.save(tmp_path / "loop.vpmap")
     assert (tmp_path / "loop.vpmap").read_bytes() == (cli_outputs / "cli.vpmap").read_bytes()
 

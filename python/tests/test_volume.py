@@ -102,6 +102,27 @@ def test_save_load_round_trip(plane_volume: voxplan.Volume, tmp_path: Path) -> N
     assert np.array_equal(loaded.extract_mesh().vertices, plane_volume.extract_mesh().vertices)
 
 
+def test_the_up_axis_is_saved_and_loaded(plane_volume: voxplan.Volume, tmp_path: Path) -> None:
+    assert plane_volume.up == "unknown"
+    plane_volume.save(tmp_path / "unknown.vpmap")
+    assert voxplan.Volume.load(tmp_path / "unknown.vpmap").up == "unknown"
+    for given, recorded in (("y", "+y"), ("-z", "-z"), ("+x", "+x")):
+        plane_volume.up = given
+        assert plane_volume.up == recorded
+        plane_volume.save(tmp_path / "up.vpmap")
+        loaded = voxplan.Volume.load(tmp_path / "up.vpmap")
+        assert loaded.up == recorded
+        assert np.array_equal(loaded.block_indices(), plane_volume.block_indices())
+    with pytest.raises(ValueError, match="up axis"):
+        plane_volume.up = "sideways"
+    # The up axis is in the header (offset 28, version 2); the blocks are the same bytes.
+    a = (tmp_path / "unknown.vpmap").read_bytes()
+    b = (tmp_path / "up.vpmap").read_bytes()
+    assert a[8:12] == b[8:12] == (2).to_bytes(4, "little")
+    assert a[28:32] == bytes(4) and b[28:32] == (1).to_bytes(4, "little")  # +x
+    assert a[32:-8] == b[32:-8]
+
+
 def test_uint16_depth_with_scale_gives_the_same_map(tmp_path: Path) -> None:
     depth_m = np.round(plane_depth(PLANE_POSE) * 5000) / 5000  # what a 16-bit PNG holds
     raw = np.round(depth_m * 5000).astype(np.uint16)

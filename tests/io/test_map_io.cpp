@@ -17,7 +17,8 @@ namespace {
 
 namespace fs = std::filesystem;
 
-constexpr size_t kHeaderBytes = 28;
+constexpr size_t kHeaderBytes = 32;    // version 2: the up axis after the block count
+constexpr size_t kHeaderBytesV1 = 28;  // version 1: no up axis
 constexpr size_t kRecordBytes = 12 + sizeof(TsdfBlock);
 
 // Blocks at random indices (negative ones included) filled with random bytes; inserted in
@@ -183,7 +184,7 @@ TEST(MapIo, RefusesWrongVersionAndBadMagic) {
   const uint32_t seven = 7;
   std::memcpy(version7.data() + 8, &seven, 4);
   ExpectRefused(dir, WithFreshChecksum(version7), StatusCode::kUnsupported,
-                "version 7, this build reads version 1");
+                "version 7, this build reads versions 1 to 2");
   auto header = ReadMapHeader((dir / "bad.vpmap").string());
   EXPECT_EQ(header.status().code(), StatusCode::kUnsupported);
 
@@ -226,6 +227,97 @@ TEST(MapIo, RefusesInvalidParamsAndDuplicateBlocks) {
   const uint64_t count = ~0ull / 3;
   std::memcpy(huge.data() + 20, &count, 8);
   ExpectRefused(dir, WithFreshChecksum(huge), StatusCode::kCorruptData, "truncated");
+}
+
+TEST(MapIo, UpAxisRoundTrips) {
+  test::TempDir dir("map_io");
+  const TsdfVolume volume = RandomVolume(13, 20);
+  for (WorldUp up : {WorldUp::kUnknown, WorldUp::kPlusX, WorldUp::kMinusX, WorldUp::kPlusY,
+                     WorldUp::kMinusY, WorldUp::kPlusZ, WorldUp::kMinusZ}) {
+    SCOPED_TRACE(WorldUpName(up));
+    const std::string path = (dir / "up.vpmap").string();
+    ASSERT_TRUE(SaveMap(volume, path, up).ok());
+    const std::string bytes = Bytes(path);
+    ASSERT_EQ(bytes.size(), kHeaderBytes + 20 * kRecordBytes + 8);
+    uint32_t stored = 99;
+    std::memcpy(&stored, bytes.data() + 28, 4);
+    EXPECT_EQ(stored, uint32_t(up));
+    WorldUp loaded_up = WorldUp::kMinusZ == up ? WorldUp::kPlusX : WorldUp::kMinusZ;
+    auto loaded = LoadMap(path, &loaded_up);
+    ASSERT_TRUE(loaded.ok()) << loaded.status().message();
+    EXPECT_EQ(loaded_up, up);
+    ExpectIdentical(volume, *loaded);
+    auto header = ReadMapHeader(path);
+    ASSERT_TRUE(header.ok());
+    EXPECT_EQ(header->version, 2u);
+    EXPECT_EQ(header->up, up);
+  }
+  // A default save records no up axis; the up axis changes the bytes, the blocks not.
+  const std::string a = (dir / "a.vpmap").string(), b = (dir / "b.vpmap").string();
+  ASSERT_TRUE(SaveMap(volume, a).ok());
+  ASSERT_TRUE(SaveMap(volume, b, WorldUp::kPlusY).ok());
+  EXPECT_EQ(ReadMapHeader(a)->up, WorldUp::kUnknown);
+  const std::string bytes_a = Bytes(a), bytes_b = Bytes(b);
+  ASSERT_EQ(bytes_a.size(), bytes_b.size());
+  EXPECT_NE(bytes_a.substr(0, kHeaderBytes), bytes_b.substr(0, kHeaderBytes));
+  const size_t blocks_bytes = bytes_a.size() - kHeaderBytes - 8;
+  EXPECT_EQ(bytes_a.substr(kHeaderBytes, blocks_bytes), bytes_b.substr(kHeaderBytes, blocks_bytes));
+}
+
+// Version 1 files, written before the up axis: the same header without it, the checksum over
+// what is there. They load as they did, with the up axis unknown.
+TEST(MapIo, ReadsVersionOneFilesAsUnknownUp) {
+  test::TempDir dir("map_io");
+  const TsdfVolume volume = RandomVolume(17, 30);
+  const std::string v2 = (dir / "v2.vpmap").string();
+  ASSERT_TRUE(SaveMap(volume, v2, WorldUp::kPlusY).ok());
+  const std::string bytes = Bytes(v2);
+  std::string v1 = bytes.substr(0, kHeaderBytesV1) + bytes.substr(kHeaderBytes);
+  const uint32_t one = 1;
+  std::memcpy(v1.data() + 8, &one, 4);
+  v1 = WithFreshChecksum(v1);
+  ASSERT_EQ(v1.size(), kHeaderBytesV1 + 30 * kRecordBytes + 8);
+  const std::string path = (dir / "v1.vpmap").string();
+  Store(path, v1);
+  WorldUp up = WorldUp::kPlusY;
+  auto loaded = LoadMap(path, &up);
+  ASSERT_TRUE(loaded.ok()) << loaded.status().message();
+  EXPECT_EQ(up, WorldUp::kUnknown);
+  ExpectIdentical(volume, *loaded);
+  auto header = ReadMapHeader(path);
+  ASSERT_TRUE(header.ok()) << header.status().message();
+  EXPECT_EQ(header->version, 1u);
+  EXPECT_EQ(header->num_blocks, 30u);
+  EXPECT_EQ(header->up, WorldUp::kUnknown);
+  // An empty version 1 map: header and checksum only.
+  std::string empty = std::string(v1.data(), kHeaderBytesV1);
+  const uint64_t none = 0;
+  std::memcpy(empty.data() + 20, &none, 8);
+  empty = WithFreshChecksum(empty + std::string(8, '\0'));
+  Store(path, empty);
+  auto nothing = LoadMap(path, &up);
+  ASSERT_TRUE(nothing.ok()) << nothing.status().message();
+  EXPECT_EQ(nothing->num_blocks(), 0u);
+  // Saved again, it becomes version 2 with the same blocks.
+  ASSERT_TRUE(SaveMap(*loaded, (dir / "again.vpmap").string()).ok());
+  EXPECT_EQ(ReadMapHeader((dir / "again.vpmap").string())->version, kMapFormatVersion);
+  // Its damage is found as before: a truncated version 1 file, a flipped bit.
+  ExpectRefused(dir, v1.substr(0, kHeaderBytesV1 + 5), StatusCode::kCorruptData, "truncated");
+  std::string flipped = v1;
+  flipped[kHeaderBytesV1 + 100] = char(flipped[kHeaderBytesV1 + 100] ^ 1);
+  ExpectRefused(dir, flipped, StatusCode::kCorruptData, "checksum mismatch");
+}
+
+TEST(MapIo, RefusesAnUnknownUpAxisCode) {
+  test::TempDir dir("map_io");
+  const std::string good = (dir / "good.vpmap").string();
+  ASSERT_TRUE(SaveMap(RandomVolume(5, 3), good).ok());
+  std::string bad = Bytes(good);
+  const uint32_t seven = 7;
+  std::memcpy(bad.data() + 28, &seven, 4);
+  ExpectRefused(dir, WithFreshChecksum(bad), StatusCode::kCorruptData, "invalid up axis 7");
+  EXPECT_FALSE(ReadMapHeader((dir / "bad.vpmap").string()).ok());
+  EXPECT_FALSE(SaveMap(RandomVolume(5, 3), good, WorldUp(9)).ok());
 }
 
 TEST(MapIo, MissingFileIsNotFound) {

@@ -4,6 +4,7 @@
 // refused with the reason, and ROS 2 bags refused saying how to convert them.
 #include <gtest/gtest.h>
 
+#include <chrono>
 #include <filesystem>
 #include <fstream>
 #include <string>
@@ -339,6 +340,99 @@ TEST(RosBag, BadBagsAreRefusedWithTheReason) {
   auto ds = OpenOk(dir / "short.bag", k);
   ASSERT_TRUE(ds);
   ExpectError(ds->Load(0).status(), {"short.bag: topic /depth message 0", "8 bytes of data"});
+}
+
+// The top-level records of a bag (format 2.0): where each starts, its op, where its header and
+// data lie. For the tests below, which corrupt one length or field.
+struct BagRecord {
+  size_t pos = 0, header_pos = 0, header_len = 0, data_pos = 0, data_len = 0;
+  int op = -1;
+};
+uint32_t GetU32(const std::string& b, size_t at) {
+  uint32_t v = 0;
+  for (int i = 3; i >= 0; --i) v = (v << 8) | uint8_t(b[at + size_t(i)]);
+  return v;
+}
+void PutU32At(std::string& b, size_t at, uint32_t v) {
+  for (int i = 0; i < 4; ++i) b[at + size_t(i)] = char((v >> (8 * i)) & 0xff);
+}
+std::vector<BagRecord> BagRecords(const std::string& b) {
+  std::vector<BagRecord> out;
+  for (size_t pos = 13; pos + 8 <= b.size();) {
+    BagRecord r;
+    r.pos = pos;
+    r.header_pos = pos + 4;
+    r.header_len = GetU32(b, pos);
+    r.data_pos = r.header_pos + r.header_len + 4;
+    r.data_len = GetU32(b, r.header_pos + r.header_len);
+    const size_t op = b.find(std::string("op=", 3), r.header_pos);
+    if (op < r.header_pos + r.header_len) r.op = uint8_t(b[op + 3]);
+    out.push_back(r);
+    pos = r.data_pos + r.data_len;
+  }
+  return out;
+}
+// Where the value of `name=` starts in the record's header.
+size_t FieldValue(const std::string& b, const BagRecord& r, const std::string& name) {
+  const size_t at = b.find(name + "=", r.header_pos);
+  EXPECT_LT(at, r.header_pos + r.header_len) << name;
+  return at + name.size() + 1;
+}
+
+// rosbag_storage trusts the file's lengths (a header length it allocates, an index entry's offset
+// it reads at): io/rosbag_check.h refuses each corruption first, naming the file and the byte.
+// The first case is what fuzz_rosbag found (rosbag allocating a 4 GiB header).
+TEST(RosBag, CorruptStructureIsRefusedBeforeRosbagReadsIt) {
+  const test::TempDir dir("voxplan-bag-structure");
+  test::WriteBag((dir / "good.bag").string(), test::BagScene{});
+  const std::string good = test::ReadFileBytes(dir / "good.bag");
+  const std::vector<BagRecord> records = BagRecords(good);
+  ASSERT_GT(records.size(), 4u);
+  ASSERT_EQ(records[0].op, 3);
+  const auto first = [&](int op) {
+    for (const BagRecord& r : records)
+      if (r.op == op) return r;
+    ADD_FAILURE() << "no record with op " << op;
+    return BagRecord{};
+  };
+  const auto refused = [&](const std::string& name, const std::string& bytes,
+                           std::initializer_list<std::string> what) {
+    WriteText(dir / name, bytes);
+    const auto start = std::chrono::steady_clock::now();
+    ExpectError(OpenDataset((dir / name).string()).status(), what);
+    EXPECT_LT(std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count(), 5.0);
+  };
+  std::string b = good;
+  PutU32At(b, records[0].pos, 0xfffffff0u);
+  refused("header_len.bag", b, {"header_len.bag", "record at byte 13", "runs past the end"});
+  b = good;
+  PutU32At(b, records[1].header_pos + records[1].header_len, 0x7fffffffu);
+  refused("data_len.bag", b, {"data_len.bag", "data of 2147483647 bytes runs past the end"});
+  b = good;
+  PutU32At(b, records[1].header_pos, 0xffffu);  // the first field's length
+  refused("field.bag", b, {"field.bag", "runs past the header's end"});
+  const BagRecord index = first(4), chunk = first(5);
+  b = good;
+  PutU32At(b, index.data_pos + 8, 0xffffff00u);  // the first entry's offset in its chunk
+  refused("offset.bag", b, {"offset.bag", "the message at offset 4294967040", "past the chunk"});
+  b = good;
+  PutU32At(b, index.data_pos + 8, 0);  // the chunk's first record: a connection, not a message
+  refused("not_message.bag", b, {"not_message.bag", "not a message data record"});
+  b = good;
+  PutU32At(b, FieldValue(b, index, "conn"), 777);
+  refused("conn.bag", b, {"conn.bag", "connection 777, which the bag does not declare"});
+  b = good;
+  PutU32At(b, FieldValue(b, chunk, "size"), uint32_t(chunk.data_len + 1));
+  refused("size.bag", b, {"size.bag", "states size"});
+  b = good;
+  b.replace(FieldValue(b, chunk, "compression"), 4, "lz4x");
+  refused("compression.bag", b, {"compression.bag", "compression 'lz4x'"});
+  b = good;
+  for (int i = 0; i < 8; ++i) b[FieldValue(b, records[0], "index_pos") + size_t(i)] = 0;
+  refused("unindexed.bag", b, {"unindexed.bag", "unindexed", "rosbag reindex"});
+  b = good;
+  b[11] = '1';
+  refused("v1.bag", b, {"v1.bag", "version '2.1'", "only 2.0"});
 }
 
 void ExpectRos2Refusal(const fs::path& path) {

@@ -1,10 +1,14 @@
 // System tests of `voxplan render` and `voxplan eval trajectory`: the built executable run as a
 // user would, checking exit codes, the JSON last line, the images written and, on failure, that
-// nothing was written.
+// nothing was written; the up axis a map records (and a version 1 map's default), and upright
+// renders at a y-flipped dataset's poses.
 #include <gtest/gtest.h>
 #include <sys/wait.h>
 
+#include <algorithm>
+#include <cmath>
 #include <cstdlib>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <nlohmann/json.hpp>
@@ -12,6 +16,7 @@
 #include <string>
 #include <vector>
 
+#include "core/index.h"
 #include "core/mesh.h"
 #include "core/volume.h"
 #include "io/image_io.h"
@@ -67,6 +72,51 @@ void WritePlaneMap(const fs::path& path) {
     }
   }
   ASSERT_TRUE(SaveMap(volume, path.string()).ok());
+}
+
+// Rewrites a map as version 1 wrote it: no up field after the block count, version 1, the
+// checksum (FNV-1a 64) over the rest.
+void RewriteAsVersion1(const fs::path& path) {
+  std::string bytes = ReadAll(path);
+  bytes = bytes.substr(0, 28) + bytes.substr(32, bytes.size() - 32 - 8);
+  const uint32_t one = 1;
+  std::memcpy(bytes.data() + 8, &one, 4);
+  uint64_t h = 0xcbf29ce484222325ull;
+  for (unsigned char c : bytes) h = (h ^ c) * 0x100000001b3ull;
+  bytes.append(reinterpret_cast<const char*>(&h), 8);
+  std::ofstream(path, std::ios::binary | std::ios::trunc) << bytes;
+}
+
+// An ICL-like map: a y-up world (ICL-NUIM's convention) holding a 4 x 4 m floor at y = 0 and a
+// 2.4 m wall at z = -2 facing +z, observed from inside the room (above the floor, in front of
+// the wall), saved with the up axis `up`; `version1` rewrites the file as version 1 wrote it.
+void WriteYUpRoomMap(const fs::path& path, WorldUp up, bool version1 = false) {
+  const float voxel = 0.05f, trunc = 0.2f;
+  TsdfVolume volume(VolumeParams{voxel, trunc});
+  const float block_m = voxel * kBlockSide;
+  const auto sdf = [](const Eigen::Vector3f& p) {
+    const float floor = p.y(), wall = p.z() + 2.0f;
+    if (p.y() > 2.4f) return floor;  // above the wall's top only the floor is near
+    return std::min(floor, wall);
+  };
+  for (int bx = -5; bx < 5; ++bx)
+    for (int by = -1; by < 7; ++by)
+      for (int bz = -6; bz < 5; ++bz) {
+        const BlockIndex b{bx, by, bz};
+        const Eigen::Vector3f centre =
+            (Eigen::Vector3f(float(bx), float(by), float(bz)) + Eigen::Vector3f::Constant(0.5f)) *
+            block_m;
+        if (std::abs(sdf(centre)) > trunc + block_m) continue;
+        TsdfBlock& block = volume.FindOrAllocate(b);
+        for (int i = 0; i < kBlockVoxels; ++i) {
+          const Eigen::Vector3f c = VoxelCenter(GlobalOf(b, VoxelOfLinear(i)), voxel);
+          block.tsdf[i] = EncodeTsdf(std::clamp(sdf(c) / trunc, -1.0f, 1.0f));
+          block.weight[i] = EncodeWeight(std::abs(c.x()) < 2.0f ? 10.0f : 0.0f);
+          block.r[i] = 150, block.g[i] = 120, block.b[i] = 90;
+        }
+      }
+  ASSERT_TRUE(SaveMap(volume, path.string(), up).ok());
+  if (version1) RewriteAsVersion1(path);
 }
 
 bool EmptyOrMissing(const fs::path& dir) {
@@ -191,6 +241,176 @@ TEST(RenderCliTest, RefusesBadArgumentsAndWritesNothing) {
   const RunResult below_file = RunCli({"render", mesh.string(), "--out", (file / "sub").string()});
   EXPECT_EQ(below_file.exit_code, 2) << Describe(below_file);
   EXPECT_EQ(ReadAll(file), "x");
+}
+
+// Normals mode: the floor (normal +y, green 255) and the wall (normal +z, blue 255) pixels of a
+// view, and their mean rows.
+struct RoomView {
+  int floor = 0, wall = 0;
+  double floor_row = 0.0, wall_row = 0.0;
+};
+RoomView SeeRoom(const ColorImage& image) {
+  RoomView r;
+  for (int v = 0; v < image.height; ++v)
+    for (int u = 0; u < image.width; ++u) {
+      const uint32_t c = image.at(u, v);
+      if (Green(c) > 240) {
+        ++r.floor;
+        r.floor_row += v;
+      } else if (Blue(c) > 240 && Green(c) > 60 && Green(c) < 200) {
+        ++r.wall;
+        r.wall_row += v;
+      }
+    }
+  if (r.floor > 0) r.floor_row /= r.floor;
+  if (r.wall > 0) r.wall_row /= r.wall;
+  return r;
+}
+
+// The orbit turns about the up axis the map records: an ICL-like (y-up) map shows its room
+// upright, the floor seen from above in every view and below the wall wherever the wall is in
+// view. About z (a version 1 map's default, or --up z) the room lies on its side: some views
+// see the floor only from below (nothing: rays pass back faces), the others above the wall.
+TEST(RenderCliTest, OrbitsAboutTheUpAxisTheMapRecords) {
+  const test::TempDir dir("voxplan-render-up");
+  const fs::path map = dir / "room.vpmap", old_map = dir / "room_v1.vpmap";
+  WriteYUpRoomMap(map, WorldUp::kPlusY);
+  WriteYUpRoomMap(old_map, WorldUp::kPlusY, /*version1=*/true);
+  const auto orbit = [&](const fs::path& input, const std::string& tag,
+                         std::vector<std::string> extra) {
+    std::vector<std::string> args = {
+        "render", input.string(), "--orbit", "8",     "--size",
+        "80x60",  "--mode",       "normals", "--out", (dir / tag).string()};
+    args.insert(args.end(), extra.begin(), extra.end());
+    const RunResult r = RunCli(args);
+    EXPECT_EQ(r.exit_code, 0) << Describe(r);
+    return r;
+  };
+  const RunResult recorded = orbit(map, "recorded", {});
+  const RunResult about_z = orbit(map, "z", {"--up", "z"});
+  const RunResult version1 = orbit(old_map, "v1", {});
+  const RunResult given_y = orbit(old_map, "v1_y", {"--up", "y"});
+  EXPECT_EQ(recorded.last_json.at("up"), json::array({0.0, 1.0, 0.0})) << Describe(recorded);
+  EXPECT_EQ(recorded.last_json.at("up_source"), "map");
+  EXPECT_EQ(about_z.last_json.at("up_source"), "--up");
+  EXPECT_EQ(version1.last_json.at("up"), json::array({0.0, 0.0, 1.0})) << Describe(version1);
+  EXPECT_EQ(version1.last_json.at("up_source"), "default");
+  EXPECT_GT(recorded.last_json.at("hit_fraction").get<double>(), 0.15) << Describe(recorded);
+  int walls_seen = 0, z_views_without_floor = 0, z_floor_above_wall = 0;
+  for (int k = 0; k < 8; ++k) {
+    const std::string name = "render_00" + std::to_string(k) + ".png";
+    // A version 1 map renders as before (about z); --up y gives it the recorded axis' views.
+    EXPECT_EQ(ReadAll(dir / "v1" / name), ReadAll(dir / "z" / name)) << name;
+    EXPECT_EQ(ReadAll(dir / "v1_y" / name), ReadAll(dir / "recorded" / name)) << name;
+    Result<ColorImage> upright = ReadColorImage((dir / "recorded" / name).string());
+    Result<ColorImage> sideways = ReadColorImage((dir / "z" / name).string());
+    ASSERT_TRUE(upright.ok() && sideways.ok());
+    const RoomView r = SeeRoom(*upright), z = SeeRoom(*sideways);
+    EXPECT_GT(r.floor, upright->width * upright->height / 10) << name;
+    if (r.wall > 20) {
+      ++walls_seen;
+      EXPECT_LT(r.wall_row + 5.0, r.floor_row) << name;
+    }
+    z_views_without_floor += z.floor == 0;
+    z_floor_above_wall += z.floor > 20 && z.wall > 20 && z.floor_row + 5.0 < z.wall_row;
+  }
+  EXPECT_GE(walls_seen, 4);
+  EXPECT_GE(z_views_without_floor, 2);
+  EXPECT_GE(z_floor_above_wall, 2);
+
+  // voxplan info reports the recorded axis, and unknown for version 1.
+  const RunResult info = RunCli({"info", map.string()});
+  ASSERT_EQ(info.exit_code, 0) << Describe(info);
+  EXPECT_EQ(info.last_json.at("version"), 2);
+  EXPECT_EQ(info.last_json.at("up"), "+y");
+  const RunResult old_info = RunCli({"info", old_map.string()});
+  ASSERT_EQ(old_info.exit_code, 0) << Describe(old_info);
+  EXPECT_EQ(old_info.last_json.at("version"), 1);
+  EXPECT_EQ(old_info.last_json.at("up"), "unknown");
+  EXPECT_EQ(
+      RunCli({"render", map.string(), "--up", "w", "--out", (dir / "bad").string()}).exit_code, 2);
+}
+
+// Mean green (normals mode: the world normal's y, 0 for -y, 255 for +y) of the hit pixels in
+// rows [v0, v1).
+double MeanGreen(const ColorImage& image, int v0, int v1) {
+  double sum = 0.0;
+  int n = 0;
+  for (int v = v0; v < v1; ++v)
+    for (int u = 0; u < image.width; ++u)
+      if (image.at(u, v) != PackRgb(48, 48, 48)) sum += Green(image.at(u, v)), ++n;
+  return n > 0 ? sum / n : -1.0;
+}
+
+// ICL-NUIM (fy = -480, y up) fused, then rendered at its frames: the pictures are its frames',
+// upright, with the ceiling (normal -y) on top; the same pose through a y-down camera would be
+// upside down (render warns), and --intrinsics with the negative fy gives the dataset's picture.
+TEST(RenderCliTest, RendersUprightAtAYFlippedDatasetsPoses) {
+  const test::TempDir dir("voxplan-render-icl");
+  const fs::path map = dir / "icl.vpmap";
+  const RunResult fused =
+      RunCli({"fuse", test::IclDir().string(), "--start", "80", "--frames", "30", "--voxel-size",
+              "0.02", "--trunc", "0.08", "--threads", "2", "--map", map.string()});
+  ASSERT_EQ(fused.exit_code, 0) << Describe(fused);
+  EXPECT_EQ(fused.last_json.at("up"), "+y");
+  EXPECT_NE(fused.last_json.at("up_source").get<std::string>().find("ICL-NUIM"), std::string::npos);
+  const RunResult ds_info = RunCli({"info", test::IclDir().string()});
+  EXPECT_EQ(ds_info.last_json.at("up"), "+y") << Describe(ds_info);
+
+  const RunResult at =
+      RunCli({"render", map.string(), "--dataset", test::IclDir().string(), "--start", "99",
+              "--frames", "2", "--mode", "normals", "--out", (dir / "at").string()});
+  ASSERT_EQ(at.exit_code, 0) << Describe(at);
+  EXPECT_EQ(at.last_json.at("views"), 2);
+  EXPECT_EQ(at.last_json.at("dataset_frames"), json::array({99, 100}));
+  EXPECT_EQ(at.last_json.at("camera").at("fy").get<float>(), -480.f);
+  EXPECT_EQ(at.last_json.at("rows_flipped"), false);
+  EXPECT_EQ(at.last_json.at("dollhouse"), false);
+  EXPECT_GT(at.last_json.at("hit_fraction").get<double>(), 0.5) << Describe(at);
+  Result<ColorImage> image = ReadColorImage((dir / "at" / "render_000.png").string());
+  ASSERT_TRUE(image.ok());
+  ASSERT_EQ(image->width, 640);
+  ASSERT_EQ(image->height, 480);
+  // Frame id 100 looks at the ceiling's edge: the ceiling (normal -y) fills the top rows.
+  EXPECT_LT(MeanGreen(*image, 0, 80), 60.0);
+  EXPECT_GT(MeanGreen(*image, 400, 480), 100.0);
+
+  // Its ground-truth pose (id 100), as --pose with a y-down camera: upside down, warned.
+  std::ifstream gt(test::IclDir() / "traj0.gt.freiburg");
+  std::string line, pose;
+  while (std::getline(gt, line))
+    if (line.rfind("100 ", 0) == 0) pose = line.substr(4);
+  ASSERT_FALSE(pose.empty());
+  const RunResult y_down = RunCli({"render", map.string(), "--pose", pose, "--size", "640x480",
+                                   "--mode", "normals", "--out", (dir / "y_down").string()});
+  ASSERT_EQ(y_down.exit_code, 0) << Describe(y_down);
+  EXPECT_NE(y_down.err.find("upside down"), std::string::npos) << Describe(y_down);
+  Result<ColorImage> flipped = ReadColorImage((dir / "y_down" / "render_000.png").string());
+  ASSERT_TRUE(flipped.ok());
+  EXPECT_LT(MeanGreen(*flipped, 400, 480), 60.0);  // the ceiling at the bottom
+  // With the dataset's camera, the dataset's picture.
+  const RunResult given =
+      RunCli({"render", map.string(), "--pose", pose, "--size", "640x480", "--intrinsics",
+              "481.2,-480,319.5,239.5", "--mode", "normals", "--out", (dir / "given").string()});
+  ASSERT_EQ(given.exit_code, 0) << Describe(given);
+  EXPECT_EQ(given.err.find("upside down"), std::string::npos) << Describe(given);
+  EXPECT_EQ(ReadAll(dir / "given" / "render_000.png"), ReadAll(dir / "at" / "render_000.png"));
+
+  // A version 1 map of it records no up axis: at the dataset's poses, the dataset's is taken.
+  const fs::path old_map = dir / "icl_v1.vpmap";
+  fs::copy_file(map, old_map);
+  RewriteAsVersion1(old_map);
+  const RunResult old_at =
+      RunCli({"render", old_map.string(), "--dataset", test::IclDir().string(), "--start", "99",
+              "--frames", "2", "--mode", "normals", "--out", (dir / "old_at").string()});
+  ASSERT_EQ(old_at.exit_code, 0) << Describe(old_at);
+  EXPECT_EQ(old_at.last_json.at("up_source"), "dataset");
+  EXPECT_EQ(old_at.last_json.at("up"), json::array({0.0, 1.0, 0.0}));
+  EXPECT_EQ(ReadAll(dir / "old_at" / "render_000.png"), ReadAll(dir / "at" / "render_000.png"));
+
+  const RunResult usage = RunCli({"render", map.string(), "--dataset", test::IclDir().string(),
+                                  "--orbit", "2", "--out", (dir / "bad").string()});
+  EXPECT_EQ(usage.exit_code, 2) << Describe(usage);
 }
 
 TEST(EvalTrajectoryCliTest, ScoresAndRefusesNoOverlap) {

@@ -1,5 +1,6 @@
 // The render job below the CLI: views of an analytic sphere map (orbit and single pose, image
-// sizes, hit fractions) and the all-or-nothing writing of their files.
+// sizes, hit fractions), upright pictures for a y-flipped camera, and the all-or-nothing
+// writing of their files.
 #include <gtest/gtest.h>
 
 #include <filesystem>
@@ -131,6 +132,128 @@ TEST(RenderViewsTest, ChoosingTheSideOrbitsBelowASurfaceSeenOnlyFromBelow) {
   Result<RenderedViews> round = RenderViews(sphere, params);
   ASSERT_TRUE(round.ok());
   EXPECT_FALSE(round->from_below);
+}
+
+// --- A y-flipped camera (fy < 0, ICL-NUIM's) ---------------------------------------------------
+
+// Hit pixels in the top and in the bottom half of an image (depth mode: misses are black).
+std::pair<int, int> HitsTopBottom(const ColorImage& image) {
+  int top = 0, bottom = 0;
+  for (int v = 0; v < image.height; ++v)
+    for (int u = 0; u < image.width; ++u)
+      if (image.at(u, v) != PackRgb(0, 0, 0)) (v < image.height / 2 ? top : bottom) += 1;
+  return {top, bottom};
+}
+
+bool SameUpToRowFlip(const ColorImage& a, const ColorImage& b) {
+  if (a.width != b.width || a.height != b.height) return false;
+  for (int v = 0; v < a.height; ++v)
+    for (int u = 0; u < a.width; ++u)
+      if (a.at(u, v) != b.at(u, a.height - 1 - v)) return false;
+  return true;
+}
+
+// The sphere at (0.5, 0.5, 0.5) seen from 1.5 m along -x, the optical axis 0.25 m below its
+// centre, so that an upright picture (world up +z) shows it in its top half.
+constexpr float kBelow = 0.25f;
+PinholeCamera Flipped(PinholeCamera camera) {
+  camera.fy = -camera.fy;
+  return camera;
+}
+
+TEST(RenderViewsTest, AYFlippedCameraAtItsOwnPosesIsUprightAsItsFrames) {
+  const MapScene scene = SphereScene();
+  RenderViewsParams params = SmallViews();
+  params.mode = ShadeMode::kDepth;
+  // ICL-NUIM's convention: the camera's +y points up (world +z), x = y cross z.
+  Pose3f icl = Pose3f::Identity();
+  icl.linear().col(1) = Eigen::Vector3f::UnitZ();
+  icl.linear().col(2) = Eigen::Vector3f::UnitX();
+  icl.linear().col(0) = icl.linear().col(1).cross(icl.linear().col(2));
+  icl.translation() = kSphere.c + Eigen::Vector3f(-1.5f, 0.f, -kBelow);
+  params.T_W_C = icl;
+  const PinholeCamera y_down = CameraFromFov(kWidth, kHeight, 60.f);  // cy at the image centre
+  params.camera = Flipped(y_down);
+  Result<RenderedViews> flipped = RenderViews(scene, params);
+  ASSERT_TRUE(flipped.ok()) << flipped.status().message();
+  EXPECT_FALSE(flipped->rows_flipped);  // its top rows look up already
+  EXPECT_LT(flipped->camera.fy, 0.f);
+  const auto [top, bottom] = HitsTopBottom(flipped->images[0]);
+  EXPECT_GT(top, 10 * std::max(bottom, 1)) << top << " " << bottom;  // upright: sphere on top
+
+  // The same pose with a y-down camera: the same picture upside down, row for row.
+  params.camera = y_down;
+  Result<RenderedViews> y_down_view = RenderViews(scene, params);
+  ASSERT_TRUE(y_down_view.ok());
+  EXPECT_FALSE(y_down_view->rows_flipped);
+  EXPECT_TRUE(SameUpToRowFlip(flipped->images[0], y_down_view->images[0]));
+  EXPECT_EQ(y_down_view->hit_fraction, flipped->hit_fraction);
+}
+
+TEST(RenderViewsTest, AYFlippedCameraAtUprightPosesRendersItsRowsFlipped) {
+  const MapScene scene = SphereScene();
+  RenderViewsParams params = SmallViews();
+  params.mode = ShadeMode::kNormals;  // world normals: the same colours either way up
+  const PinholeCamera y_down = CameraFromFov(kWidth, kHeight, 60.f);
+  // A level pose built for a y-down image (LookAt), and an orbit.
+  params.T_W_C = LookAt(kSphere.c + Eigen::Vector3f(-1.5f, 0.f, -kBelow),
+                        kSphere.c + Eigen::Vector3f(0.f, 0.f, -kBelow));
+  for (bool orbit : {false, true}) {
+    SCOPED_TRACE(orbit ? "orbit" : "pose");
+    if (orbit) {
+      params.T_W_C.reset();
+      params.orbit_views = 3;
+    }
+    params.camera = y_down;
+    Result<RenderedViews> upright = RenderViews(scene, params);
+    params.camera = Flipped(y_down);
+    params.camera->cy = 20.f;  // off centre: mirrored to height - 1 - 20 for the flipped rows
+    Result<RenderedViews> flipped = RenderViews(scene, params);
+    ASSERT_TRUE(upright.ok() && flipped.ok());
+    EXPECT_FALSE(upright->rows_flipped);
+    EXPECT_TRUE(flipped->rows_flipped);
+    EXPECT_EQ(flipped->camera.fy, y_down.fy);
+    EXPECT_EQ(flipped->camera.cy, float(kHeight - 1) - 20.f);
+    // With the principal point where the flipped camera's rows put it, the same pictures.
+    params.camera = y_down;
+    params.camera->cy = float(kHeight - 1) - 20.f;
+    Result<RenderedViews> same = RenderViews(scene, params);
+    ASSERT_TRUE(same.ok());
+    ASSERT_EQ(same->images.size(), flipped->images.size());
+    for (size_t k = 0; k < same->images.size(); ++k)
+      EXPECT_EQ(same->images[k].data, flipped->images[k].data) << k;
+  }
+  // The flip follows the up axis given: with -z up the level pose is upside down for a y-down
+  // camera, and its y-flipped twin keeps its rows.
+  params.orbit_views = 1;
+  params.T_W_C = LookAt(Eigen::Vector3f(-1.f, 0.5f, 0.5f), kSphere.c);
+  params.up_W = -Eigen::Vector3f::UnitZ();
+  params.camera = Flipped(y_down);
+  Result<RenderedViews> down_up = RenderViews(scene, params);
+  ASSERT_TRUE(down_up.ok());
+  EXPECT_FALSE(down_up->rows_flipped);
+}
+
+TEST(RenderViewsTest, UprightCameraFlipsOnlyAYFlippedCameraWhoseTopLooksDown) {
+  const PinholeCamera y_down{64, 48, 50.f, 50.f, 31.5f, 20.f};
+  const Pose3f level = LookAt(Eigen::Vector3f(-2.f, 0.f, 0.f), Eigen::Vector3f::Zero());
+  bool flipped = true;
+  const PinholeCamera same = UprightCamera(y_down, {level}, Eigen::Vector3f::UnitZ(), &flipped);
+  EXPECT_FALSE(flipped);
+  EXPECT_EQ(same.fy, y_down.fy);
+  PinholeCamera y_up = y_down;
+  y_up.fy = -50.f;
+  const PinholeCamera turned = UprightCamera(y_up, {level}, Eigen::Vector3f::UnitZ(), &flipped);
+  EXPECT_TRUE(flipped);
+  EXPECT_EQ(turned.fy, 50.f);
+  EXPECT_EQ(turned.cy, 27.f);
+  EXPECT_EQ(turned.fx, y_up.fx);
+  EXPECT_EQ(turned.cx, y_up.cx);
+  // Its top looks up when the world's up is -z; no views, no reason to flip.
+  UprightCamera(y_up, {level}, -Eigen::Vector3f::UnitZ(), &flipped);
+  EXPECT_FALSE(flipped);
+  UprightCamera(y_up, {}, Eigen::Vector3f::UnitZ(), &flipped);
+  EXPECT_FALSE(flipped);
 }
 
 }  // namespace

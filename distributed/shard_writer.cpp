@@ -1,0 +1,58 @@
+#include "distributed/shard_writer.h"
+
+#include <cstring>
+#include <filesystem>
+
+#include "io/file_util.h"
+#include "io/map_io.h"
+
+namespace voxplan {
+
+Result<ShardManifest> WriteShardedMap(Communicator& comm, const TsdfVolume& local,
+                                      const std::string& path, uint64_t generation, bool complete,
+                                      const nlohmann::json& run, const ShardManifest* previous,
+                                      WorldUp up) {
+  const std::string name = ShardFileName(path, generation, comm.rank(), comm.size());
+  const Status mine = SaveMap(local, ShardFilePath(path, name), up);
+  VOXPLAN_RETURN_IF_ERROR(AgreeOnStatus(comm, mine));
+
+  // Rank 0 learns every shard's count and checksum, and writes the manifest.
+  const uint64_t fields[2] = {uint64_t(local.num_blocks()), VolumeChecksum(local)};
+  Bytes bytes(sizeof(fields));
+  std::memcpy(bytes.data(), fields, sizeof(fields));
+  Result<std::vector<Bytes>> all = comm.Gather(bytes, 0);
+  if (!all.ok()) return all.status();
+  ShardManifest m;
+  m.ranks = uint32_t(comm.size());
+  m.params = local.params();
+  m.generation = generation;
+  m.complete = complete;
+  m.up = up;
+  m.run_json = run.dump();
+  for (int r = 0; r < comm.size(); ++r) {
+    uint64_t f[2] = {0, 0};
+    if (comm.is_root()) std::memcpy(f, (*all)[size_t(r)].data(), sizeof(f));
+    m.shards.push_back({ShardFileName(path, generation, r, comm.size()), f[0], f[1]});
+  }
+  Status written = Status::Ok();
+  if (comm.is_root()) written = WriteFileAtomically(path, ShardManifestText(m)).Naming(path);
+  VOXPLAN_RETURN_IF_ERROR(AgreeOnStatus(comm, written));
+
+  // The new manifest is in place: the shards the previous one named can go.
+  if (previous) {
+    const auto remove = [&](const ShardManifest::Shard& s) {
+      if (s.file == name || !SafeShardName(s.file)) return;
+      std::error_code ec;
+      std::filesystem::remove(ShardFilePath(path, s.file), ec);  // already gone: no error
+    };
+    if (previous->ranks == m.ranks) {
+      if (size_t(comm.rank()) < previous->shards.size())
+        remove(previous->shards[size_t(comm.rank())]);
+    } else if (comm.is_root()) {
+      for (const ShardManifest::Shard& s : previous->shards) remove(s);
+    }
+  }
+  return m;
+}
+
+}  // namespace voxplan
