@@ -19,7 +19,7 @@ Status AgreeOnStatus(Communicator& comm, const Status& local) {
   if (!local.ok() && *agreed == mine) return local;
   const int failed_rank = int(kMaxRanks - (*agreed >> 8));
   return Status(StatusCode(*agreed & 0xff),
-                "rank " + std::to_string(failed_rank) + " stopped (its message is in its log)");
+                "rank " + std::to_string(failed_rank) + " stopped (" + kOtherRankStopped + ")");
 }
 
 bool LaunchedByMpirun() {

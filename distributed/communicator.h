@@ -61,8 +61,9 @@ class SerialCommunicator final : public Communicator {
 inline constexpr int kMaxRanks = 4096;
 
 // Agrees on a failure: every rank passes its own status; all get the first failing rank's
-// code and, on the others, a message saying which rank stopped. A communication failure is
+// code and, on the others, "rank R stopped (<kOtherRankStopped>)". A communication failure is
 // returned as it is.
+inline constexpr const char* kOtherRankStopped = "its message is printed with its rank";
 Status AgreeOnStatus(Communicator& comm, const Status& local);
 
 // Whether this process was started by mpirun (its environment says so), and whether this build

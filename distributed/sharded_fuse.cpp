@@ -265,6 +265,10 @@ Status ShareDatasetInfo(Communicator& comm, DatasetInfo& info, std::vector<size_
     w.PutString(info.pose_source);
     w.Put(info.up);
     w.PutString(info.up_source);
+    w.PutString(info.depth_encoding);
+    w.Put(uint8_t(info.depth_metres));
+    w.Put(uint64_t(info.frames_bad_pose));
+    w.PutString(info.streams);
     std::vector<uint64_t> selected(indices.begin(), indices.end());
     w.PutVector(selected);
   }
@@ -285,10 +289,18 @@ Status ShareDatasetInfo(Communicator& comm, DatasetInfo& info, std::vector<size_
   r.GetString(info.pose_source);
   r.Get(info.up);
   r.GetString(info.up_source);
+  uint8_t depth_metres = 0;
+  uint64_t frames_bad_pose = 0;
+  r.GetString(info.depth_encoding);
+  r.Get(depth_metres);
+  r.Get(frames_bad_pose);
+  r.GetString(info.streams);
   r.GetVector(selected);
   VOXPLAN_RETURN_IF_ERROR(r.Finish("dataset description from rank 0"));
   info.num_frames = size_t(num_frames);
   info.has_color = has_color != 0;
+  info.depth_metres = depth_metres != 0;
+  info.frames_bad_pose = size_t(frames_bad_pose);
   indices.assign(selected.begin(), selected.end());
   return Status::Ok();
 }
@@ -343,13 +355,19 @@ Result<ShardedFuseReport> FuseDatasetSharded(Communicator& comm, const Dataset* 
         s = report.status().WithContext(params.checkpoint_path);
     }
     VOXPLAN_RETURN_IF_ERROR(AgreeOnStatus(comm, s));
-    // The budget is this run's: the loaded blocks are moved into `local`.
+    // Copied into `local`, whose memory budget then applies to the blocks this run adds.
     loaded->ForEachBlock(
         [&](BlockIndex b, const TsdfBlock& block) { local.FindOrAllocate(b) = block; });
     out.frames_resumed = start;
     out.checkpoint = std::move(manifest);
   }
 
+  if (!params.resume && !params.checkpoint_path.empty() &&
+      IsShardedMapFile(params.checkpoint_path)) {
+    // A new run over an old sharded map: its shards go once this run's first manifest is in.
+    if (Result<ShardManifest> old = ReadShardManifest(params.checkpoint_path); old.ok())
+      out.checkpoint = std::move(*old);
+  }
   FuseParams fuse = params.fuse;
   fuse.integrate.shard = {uint32_t(comm.rank()), uint32_t(comm.size())};
   const std::vector<size_t> rest(indices.begin() + std::ptrdiff_t(start), indices.end());
@@ -482,7 +500,8 @@ Result<Mesh> ExtractMeshSharded(Communicator& comm, TsdfVolume& local, const Mes
 }
 
 Result<std::vector<RankFigures>> GatherRankFigures(Communicator& comm, const TsdfVolume& local) {
-  RankFigures mine{uint64_t(local.num_blocks()), uint64_t(local.MemoryBytes()), PeakRssMb()};
+  const RankFigures mine{uint64_t(local.num_blocks()), uint64_t(local.MemoryBytes()),
+                         uint64_t(local.blocks_refused()), PeakRssMb()};
   wire::Writer w;
   w.Put(mine);
   Result<std::vector<Bytes>> all = comm.Gather(w.Take(), 0);

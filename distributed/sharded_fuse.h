@@ -22,8 +22,8 @@
 
 namespace voxplan {
 
-// Collective: rank 0's dataset description and selected frames to every rank. `info` and
-// `indices` are read on rank 0 and filled elsewhere.
+// Collective: rank 0's dataset description (all but its warnings, which rank 0 prints) and
+// selected frames to every rank. `info` and `indices` are read on rank 0 and filled elsewhere.
 Status ShareDatasetInfo(Communicator& comm, DatasetInfo& info, std::vector<size_t>& indices);
 
 struct ShardedFuseParams {
@@ -39,9 +39,11 @@ struct ShardedFuseParams {
 struct ShardedFuseReport {
   FuseReport report;          // the whole run, resumed frames included (on every rank)
   size_t frames_resumed = 0;  // selected frames a checkpoint had done before this run
-  std::optional<ShardManifest> checkpoint;  // the last one written or resumed from
-  uint64_t broadcast_bytes = 0;             // frames sent by rank 0, in all
-  std::vector<double> broadcast_ms;         // per selected frame: its broadcast
+  // The last checkpoint written or resumed from, else the sharded map the run replaces at its
+  // path (its shards are removed once the run's own manifest is in place).
+  std::optional<ShardManifest> checkpoint;
+  uint64_t broadcast_bytes = 0;      // frames sent by rank 0, in all
+  std::vector<double> broadcast_ms;  // per selected frame: its broadcast
 };
 
 // Collective. `dataset` is read on rank 0 only (elsewhere it may be null): info and indices
@@ -60,9 +62,10 @@ Result<ShardedFuseReport> FuseDatasetSharded(Communicator& comm, const Dataset* 
 Result<Mesh> ExtractMeshSharded(Communicator& comm, TsdfVolume& local, const MeshParams& params);
 
 // Per-rank figures, gathered on rank 0 (in rank order; empty elsewhere): blocks, the map's
-// bytes and the peak resident memory (MiB).
+// bytes, blocks refused by the budget and the peak resident memory (MiB).
 struct RankFigures {
   uint64_t blocks = 0, map_bytes = 0;
+  uint64_t blocks_refused = 0;  // new blocks its memory budget refused
   double peak_rss_mb = 0.0;
 };
 Result<std::vector<RankFigures>> GatherRankFigures(Communicator& comm, const TsdfVolume& local);

@@ -74,12 +74,30 @@ std::optional<int> Reap(pid_t pid, bool block) {
   }
 }
 
+// Every farm message: a task's index, a number (exit code and time, or unused) and a text (the
+// command, or empty).
+struct FarmMessage {
+  uint64_t index = 0;
+  int64_t value = 0;
+  std::string text;
+};
+
 Bytes Encode(uint64_t index, int64_t value, const std::string& text = {}) {
   wire::Writer w;
   w.Put(index);
   w.Put(value);
   w.PutString(text);
   return w.Take();
+}
+
+Result<FarmMessage> Decode(const Bytes& bytes, const std::string& what) {
+  FarmMessage m;
+  wire::Reader r(bytes);
+  r.Get(m.index);
+  r.Get(m.value);
+  r.GetString(m.text);
+  VOXPLAN_RETURN_IF_ERROR(r.Finish(what));
+  return m;
 }
 
 }  // namespace
@@ -125,19 +143,13 @@ Result<FarmResult> RunTaskFarm(Communicator& comm, const std::vector<FarmTask>& 
       Result<Bytes> msg = comm.Receive(0, &source, &tag);
       if (!msg.ok()) return msg.status();
       if (tag == kTagStop) return FarmResult{};
-      wire::Reader r(*msg);
-      uint64_t index = 0;
-      int64_t unused = 0;
-      std::string command;
-      r.Get(index);
-      r.Get(unused);
-      r.GetString(command);
-      VOXPLAN_RETURN_IF_ERROR(r.Finish("task from rank 0"));
+      Result<FarmMessage> task = Decode(*msg, "task from rank 0");
+      if (!task.ok()) return task.status();
       const Stopwatch clock;
-      Result<pid_t> pid = Spawn(command, env);
+      Result<pid_t> pid = Spawn(task->text, env);
       const int code = pid.ok() ? Reap(*pid, true).value_or(255) : 127;
       // The wall time travels in microseconds beside the exit code.
-      report = Encode(index, (int64_t(code) << 40) | int64_t(clock.ElapsedMs() * 1000.0));
+      report = Encode(task->index, (int64_t(code) << 40) | int64_t(clock.ElapsedMs() * 1000.0));
     }
   }
 
@@ -193,14 +205,10 @@ Result<FarmResult> RunTaskFarm(Communicator& comm, const std::vector<FarmTask>& 
     if (*waiting) {
       Result<Bytes> msg = comm.Receive(source, &source, &tag);
       if (!msg.ok()) return msg.status();
-      wire::Reader r(*msg);
-      uint64_t index = 0;
-      int64_t value = 0;
-      std::string unused;
-      r.Get(index);
-      r.Get(value);
-      r.GetString(unused);
-      VOXPLAN_RETURN_IF_ERROR(r.Finish("report from rank " + std::to_string(source)));
+      Result<FarmMessage> report = Decode(*msg, "report from rank " + std::to_string(source));
+      if (!report.ok()) return report.status();
+      const uint64_t index = report->index;
+      const int64_t value = report->value;
       if (index != kNoTask && index < tasks.size())
         finish(size_t(index), int(value >> 40), source,
                double(value & ((int64_t(1) << 40) - 1)) / 1e6);

@@ -14,6 +14,7 @@
 
 #include "core/bounds.h"
 #include "io/dataset_internal.h"
+#include "io/depth_image.h"
 #include "io/file_util.h"
 #include "io/image_io.h"
 #include "io/text_file.h"
@@ -138,6 +139,8 @@ Result<Frame> FrameFromEntry(const DatasetInfo& info, const std::vector<Entry>& 
 
 namespace {
 
+std::string UnitsText(bool metres) { return metres ? "metres" : "units of 1 / depth scale"; }
+
 // ---------------------------------------------------------------------------------------------
 // The one Dataset implementation: a list of frames, each a depth path, an optional colour path,
 // a timestamp and an optional pose. Readers only build the list.
@@ -155,8 +158,14 @@ class ListDataset final : public Dataset {
     if (!listed.ok()) return listed.status();
     Frame frame = std::move(listed).value();
     const Entry& e = entries_[i];
-    auto depth = ReadDepthPng(e.depth_path, info_.depth_scale);
+    DepthFileHeader header;
+    auto depth = ReadDepthImage(e.depth_path, info_.depth_scale, &header);
     if (!depth.ok()) return depth.status();
+    if (header.metres != info_.depth_metres)
+      return CorruptData(e.depth_path + ": holds " + header.Encoding() + " depth (" +
+                         UnitsText(header.metres) + ") but the sequence's first frame holds " +
+                         info_.depth_encoding + " depth (" + UnitsText(info_.depth_metres) +
+                         "); a sequence cannot mix them");
     frame.depth = std::move(depth).value();
     if (frame.depth.width != info_.camera.width || frame.depth.height != info_.camera.height)
       return CorruptData(e.depth_path + ": depth is " + std::to_string(frame.depth.width) + "x" +
@@ -185,7 +194,8 @@ class ListDataset final : public Dataset {
 // outputs (meshes, maps, images) may sit there too without being read.
 bool IsTopLevelInput(const fs::path& file) {
   static const char* const kNotRead[] = {".ply", ".obj",   ".glb", ".gltf", ".stl",
-                                         ".dae", ".vpmap", ".png", ".jpg",  ".jpeg"};
+                                         ".dae", ".vpmap", ".png", ".jpg",  ".jpeg",
+                                         ".tif", ".tiff",  ".exr"};
   std::string ext = file.extension().string();
   std::transform(ext.begin(), ext.end(), ext.begin(),
                  [](unsigned char c) { return std::tolower(c); });
@@ -280,14 +290,23 @@ Result<std::unique_ptr<Dataset>> Finish(Draft d, const DatasetOptions& options) 
       return NotFound(e.color_path + ": colour image not found" + from);
   }
 
-  // The size comes from the first depth image's header; refuse the wrong kind of PNG early.
+  // One type of depth file (by name): PNG, TIFF or EXR. The size and the units come from the
+  // first one's header, which also refuses the wrong kind of file early.
   const std::string& first = d.entries.front().depth_path;
-  auto header = ReadPngHeader(first);
+  const DepthFileType type = DepthFileTypeOf(first);
+  for (const Entry& e : d.entries)
+    if (DepthFileTypeOf(e.depth_path) != type)
+      return Unsupported(e.depth_path + ": " + DepthFileTypeName(DepthFileTypeOf(e.depth_path)) +
+                         " depth in a sequence of " + DepthFileTypeName(type) +
+                         " depth images (the first: " + first + ")");
+  auto header = ReadDepthHeader(first);
   if (!header.ok()) return header.status();
-  if (header->bit_depth != 16 || header->channels != 1 || header->palette)
-    return Unsupported(first + ": depth PNG must be 16-bit single-channel gray, found " +
-                       std::to_string(header->bit_depth) + "-bit with " +
-                       std::to_string(header->channels) + " channel(s)");
+  info.depth_encoding = header->Encoding();
+  info.depth_metres = header->metres;
+  if (header->metres && options.depth_scale)
+    info.warnings.push_back("depth scale " + NumberText(*options.depth_scale) + " given, but " +
+                            first + " holds " + info.depth_encoding +
+                            " depth in metres: the scale applies only to 16-bit depth images");
   info.camera.width = header->width;
   info.camera.height = header->height;
   if (d.stated_width > 0 && (d.stated_width != header->width || d.stated_height != header->height))

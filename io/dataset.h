@@ -57,7 +57,13 @@ struct DatasetInfo {
   DatasetFormat format = DatasetFormat::kAuto;
   std::string root;
   PinholeCamera camera;      // width/height from the first depth image
-  double depth_scale = 0.0;  // units per metre
+  double depth_scale = 0.0;  // units per metre (of 16-bit depth; float depth files are metres)
+  // Datasets of depth image files: what the first one holds (io/depth_image.h), "16-bit PNG",
+  // "16-bit TIFF", "32-bit float TIFF", "32-bit float EXR", ...; empty for the formats in one
+  // file. depth_metres: float depth in metres, the depth scale does not apply (every frame of
+  // the sequence must then hold float depth).
+  std::string depth_encoding;
+  bool depth_metres = false;
   size_t num_frames = 0;
   bool has_color = false;
   std::string intrinsics_source;      // the file they came from, "flag" or "default (...)"
@@ -95,7 +101,8 @@ class Dataset {
  public:
   virtual ~Dataset() = default;
   virtual const DatasetInfo& info() const = 0;
-  // Loads frame i (0 <= i < num_frames): decodes depth (and colour), checks sizes and bit depth.
+  // Loads frame i (0 <= i < num_frames): decodes depth (and colour), checks sizes and bit depth
+  // (and that its depth is in the units of the first frame's: all 16-bit or all float).
   // Called from several threads at once, for different frames (FuseDataset decodes ahead).
   virtual Result<Frame> Load(size_t i) const = 0;
   // Every file it reads: each frame's images, the pose and intrinsics files and the lists at

@@ -27,15 +27,20 @@ long IdFromName(const std::string& name, const std::string& prefix, const std::s
 
 }  // namespace
 
+std::vector<std::string> DepthSuffixes(const std::string& stem) {
+  return {stem + ".png", stem + ".tif", stem + ".tiff", stem + ".exr"};
+}
+
 // Frame files of one folder, sorted by id.
-Result<std::vector<std::pair<long, std::string>>> ListFrames(const fs::path& dir,
-                                                             const std::string& prefix,
-                                                             const std::string& suffix) {
+Result<std::vector<std::pair<long, std::string>>> ListFrames(
+    const fs::path& dir, const std::string& prefix, const std::vector<std::string>& suffixes) {
   std::vector<std::pair<long, std::string>> out;
   std::error_code ec;
   for (const auto& entry : fs::directory_iterator(dir, ec)) {
-    const long id = IdFromName(entry.path().filename().string(), prefix, suffix);
-    if (id >= 0) out.emplace_back(id, entry.path().string());
+    for (const std::string& suffix : suffixes) {
+      const long id = IdFromName(entry.path().filename().string(), prefix, suffix);
+      if (id >= 0) out.emplace_back(id, entry.path().string());
+    }
   }
   if (ec) return IoError(dir.string() + ": cannot list (" + ec.message() + ")");
   std::sort(out.begin(), out.end());
@@ -48,8 +53,10 @@ Result<std::vector<std::pair<long, std::string>>> ListFrames(const fs::path& dir
 
 bool HasFrames(const fs::path& dir) {
   std::error_code ec;
+  const std::vector<std::string> suffixes = DepthSuffixes(".depth");
   for (const auto& entry : fs::directory_iterator(dir, ec))
-    if (IdFromName(entry.path().filename().string(), "frame-", ".depth.png") >= 0) return true;
+    for (const std::string& suffix : suffixes)
+      if (IdFromName(entry.path().filename().string(), "frame-", suffix) >= 0) return true;
   return false;
 }
 
@@ -94,7 +101,7 @@ Status ReadCameraIntrinsicsTxt(const std::string& path, Draft& d) {
 }
 
 Status AddFrameFolder(const fs::path& dir, double time_offset, Draft& d, double* end_time) {
-  auto depth = ListFrames(dir, "frame-", ".depth.png");
+  auto depth = ListFrames(dir, "frame-", DepthSuffixes(".depth"));
   if (!depth.ok()) return depth.status();
   std::error_code ec;
   size_t missing_poses = 0;
@@ -102,7 +109,7 @@ Status AddFrameFolder(const fs::path& dir, double time_offset, Draft& d, double*
     Entry e;
     e.depth_path = path;
     // The stem keeps the file's own zero padding.
-    const std::string stem = path.substr(0, path.size() - std::string(".depth.png").size());
+    const std::string stem = path.substr(0, path.rfind(".depth."));
     for (const char* ext : {".color.png", ".color.jpg"})
       if (fs::exists(stem + ext, ec)) e.color_path = stem + ext;
     e.timestamp = time_offset + double(id) / kNoTimestampRateHz;
@@ -151,7 +158,8 @@ Result<Draft> ReadFrameFolders(const fs::path& root, DatasetFormat format) {
       intrinsics = (root / "camera-intrinsics.txt").string();
   }
   if (folders.empty())
-    return NotFound(root.string() + ": no frame-XXXXXX.depth.png files (here or in seq-XX/)");
+    return NotFound(root.string() +
+                    ": no frame-XXXXXX.depth.png (.tif, .tiff, .exr) files (here or in seq-XX/)");
 
   if (!intrinsics.empty()) {
     VOXPLAN_RETURN_IF_ERROR(ReadCameraIntrinsicsTxt(intrinsics, d));

@@ -143,11 +143,14 @@ Result<double> JsonNumber(const nlohmann::json& obj, const std::string& key,
 Result<std::string> FindOne(const fs::path& dir, const std::string& suffix);
 
 // The frame-file listing of io/dataset_frame_folders.cpp, also used by Replica and detection.
-// Files `prefix<id>suffix` of one folder, sorted by id; a duplicate id is an error.
-Result<std::vector<std::pair<long, std::string>>> ListFrames(const fs::path& dir,
-                                                             const std::string& prefix,
-                                                             const std::string& suffix);
-bool HasFrames(const fs::path& dir);                          // any frame-XXXXXX.depth.png in dir
+// Files `prefix<id>suffix` of one folder, for any of `suffixes`, sorted by id; a duplicate id
+// (also across suffixes: frame-000001.depth.png beside frame-000001.depth.exr) is an error.
+Result<std::vector<std::pair<long, std::string>>> ListFrames(
+    const fs::path& dir, const std::string& prefix, const std::vector<std::string>& suffixes);
+// The depth file types a folder of frames may hold (io/depth_image.h): `stem` + ".png", ".tif",
+// ".tiff", ".exr".
+std::vector<std::string> DepthSuffixes(const std::string& stem);
+bool HasFrames(const fs::path& dir);  // any frame-XXXXXX.depth.{png,tif,tiff,exr} in dir
 std::vector<fs::path> SequenceFolders(const fs::path& root);  // seq*/ folders with frames, sorted
 
 }  // namespace voxplan::dataset

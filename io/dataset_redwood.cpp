@@ -143,7 +143,7 @@ Result<std::vector<long>> ListFolders(const fs::path& root, Draft& d) {
   std::error_code ec;
   if (!fs::is_directory(root / "depth", ec))
     return NotFound((root / "depth").string() + ": depth folder not found");
-  auto depth_files = ListFiles(root / "depth", {".png"});
+  auto depth_files = ListFiles(root / "depth", {".png", ".tif", ".tiff", ".exr"});
   if (!depth_files.ok()) return depth_files.status();
   auto color_files = ListFiles(root / "color", {".jpg", ".jpeg", ".png"});
   if (!color_files.ok()) return color_files.status();
@@ -171,7 +171,7 @@ Result<std::vector<long>> ListFolders(const fs::path& root, Draft& d) {
     d.warnings.push_back((root / "color").string() + ": " + std::to_string(color->size() - paired) +
                          " of " + std::to_string(color->size()) +
                          " colour images have no depth image of the same number; unused");
-  d.empty_message = (root / "depth").string() + ": no PNG images";
+  d.empty_message = (root / "depth").string() + ": no depth images (.png, .tif, .tiff, .exr)";
   return ids;
 }
 

@@ -78,7 +78,7 @@ Result<Draft> ReadReplica(const fs::path& root) {
   VOXPLAN_RETURN_IF_ERROR(CheckFocalLengths(1.0, v[3], params, LineOf(params, "\"fy\"")));
 
   const fs::path results = scene / "results";
-  auto depth = ListFrames(results, "depth", ".png");
+  auto depth = ListFrames(results, "depth", DepthSuffixes(""));
   if (!depth.ok()) return depth.status();
   for (const auto& [id, path] : *depth) {
     Entry e;
@@ -91,7 +91,7 @@ Result<Draft> ReadReplica(const fs::path& root) {
     e.timestamp = double(id) / kNoTimestampRateHz;
     d.entries.push_back(std::move(e));
   }
-  d.empty_message = results.string() + ": no depthNNNNNN.png images";
+  d.empty_message = results.string() + ": no depthNNNNNN.png (.tif, .tiff, .exr) images";
 
   // traj.txt holds a pose for every frame of the full sequence; line k (0-based) is frame k.
   const std::string traj = (scene / "traj.txt").string();

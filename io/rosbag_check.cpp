@@ -18,8 +18,8 @@ namespace {
 namespace fs = std::filesystem;
 
 // Record ops of format 2.0 (rosbag/constants.h).
-constexpr uint8_t kOpMessageData = 0x02, kOpFileHeader = 0x03, kOpIndexData = 0x04,
-                  kOpChunk = 0x05, kOpChunkInfo = 0x06, kOpConnection = 0x07;
+constexpr uint8_t kOpMessageData = 0x02, kOpFileHeader = 0x03, kOpIndexData = 0x04, kOpChunk = 0x05,
+                  kOpChunkInfo = 0x06, kOpConnection = 0x07;
 constexpr char kVersionLine[] = "#ROSBAG V2.0\n";
 constexpr uint64_t kVersionBytes = sizeof(kVersionLine) - 1;
 // ros::Header::parse refuses longer fields.
@@ -133,8 +133,8 @@ class BagChecker {
       r.data_len = U32(bytes.data());
       r.data_pos = pos + 8 + header_len;
       if (r.data_len > size_ - r.data_pos)
-        return Fault(pos, "data of " + std::to_string(r.data_len) +
-                              " bytes runs past the end of the file");
+        return Fault(
+            pos, "data of " + std::to_string(r.data_len) + " bytes runs past the end of the file");
       if (r.op == kOpConnection) {  // its data is the connection's header
         Fields connection;
         VOXPLAN_RETURN_IF_ERROR(Read(r.data_pos, r.data_len, bytes));
@@ -152,8 +152,8 @@ class BagChecker {
   Result<uint64_t> Number(const Record& r, const char* name, size_t bytes) const {
     const auto f = r.fields.find(name);
     if (f == r.fields.end() || f->second.size() != bytes)
-      return Fault(r.pos, std::string("no ") + std::to_string(bytes) + "-byte '" + name +
-                              "' field");
+      return Fault(r.pos,
+                   std::string("no ") + std::to_string(bytes) + "-byte '" + name + "' field");
     uint64_t v = 0;
     for (size_t i = bytes; i-- > 0;) v = (v << 8) | uint8_t(f->second[i]);
     return v;
@@ -181,12 +181,13 @@ class BagChecker {
     if (!conn_count.ok()) return conn_count.status();
     if (!chunk_count.ok()) return chunk_count.status();
     if (*index_pos == 0)
-      return CorruptData(path_ + ": unindexed bag (its recording did not finish); `rosbag reindex` "
-                                 "repairs it");
+      return CorruptData(path_ +
+                         ": unindexed bag (its recording did not finish); `rosbag reindex` "
+                         "repairs it");
     const auto first = at_.find(*index_pos);
     if (first == at_.end())
-      return Fault(file_header.pos, "index_pos " + std::to_string(*index_pos) +
-                                        " is not the start of a record");
+      return Fault(file_header.pos,
+                   "index_pos " + std::to_string(*index_pos) + " is not the start of a record");
     size_t k = first->second;
     if (*conn_count + *chunk_count > records_.size() - k)
       return Fault(file_header.pos, "states " + std::to_string(*conn_count) + " connections and " +

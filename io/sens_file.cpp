@@ -24,6 +24,9 @@ constexpr uint32_t kSensVersion = 4;
 constexpr uint64_t kMaxSensorNameBytes = 4096;
 // A frame's record before its images: a 4x4 float pose and four uint64 (timestamps, sizes).
 constexpr uint64_t kFrameRecordBytes = 16 * 4 + 4 * 8;
+// Deflate inflates at most 1032-fold (a 258-byte match per 2 bits), plus zlib's header: a depth
+// stream too short to fill the header's image is refused before its buffer is allocated.
+constexpr uint64_t kZlibMaxRatio = 1032, kZlibSlackBytes = 64;
 
 // Little-endian reads over a file of known size; every read is checked against what is left,
 // so a size field can never move the reader past the end or allocate more than the file holds.
@@ -264,6 +267,11 @@ Result<SensIndex> ReadSensIndex(const std::string& path) {
     if (f.depth_bytes == 0) return CorruptData(where + ": no depth bytes");
     VOXPLAN_RETURN_IF_ERROR(
         CheckImageBytes(f.depth_bytes, RawDepthBytes(h), raw_depth, where, "depth"));
+    if (!raw_depth && f.depth_bytes * kZlibMaxRatio + kZlibSlackBytes < RawDepthBytes(h))
+      return CorruptData(where + ": zlib depth of " + std::to_string(f.depth_bytes) +
+                         " bytes cannot inflate to the header's " + std::to_string(h.depth_width) +
+                         "x" + std::to_string(h.depth_height) + " (" +
+                         std::to_string(RawDepthBytes(h)) + " bytes)");
     if (h.color_width == 0 && f.color_bytes > 0)
       return CorruptData(where + ": " + std::to_string(f.color_bytes) +
                          " colour bytes, but the header states no colour image size");

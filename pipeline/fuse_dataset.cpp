@@ -127,7 +127,8 @@ Result<FuseReport> FuseDataset(const Dataset& dataset, const std::vector<size_t>
       {observer, params.max_skip_warnings, "had no pose and were skipped"},
       {observer, params.max_skip_warnings, "had a pose not to trust and were skipped"},
       {observer, params.max_skip_warnings, "lay in gaps of the ground truth and were skipped"}};
-  DepthScaleCheck depth_check(info.root, info.depth_scale);
+  // Float depth is metres: no depth scale to suggest.
+  DepthScaleCheck depth_check(info.root, info.depth_metres ? 0.0 : info.depth_scale);
   SkipCounter lost(observer, params.max_skip_warnings, "lost tracking and were not integrated");
   // Selected frame k, loaded (in `load_ms`): skipped, or posed, integrated and recorded.
   const auto fuse_frame = [&](size_t k, Result<Frame>& frame, double load_ms) -> Status {

@@ -1,12 +1,69 @@
-// MapScene: bounds from the allocated blocks, one core ray cast per view.
+// MapScene: bounds from the allocated blocks, surface samples from the zero crossings, one
+// core ray cast per view.
 #include "viewer_offscreen/map_scene.h"
 
 #include <algorithm>
+#include <bitset>
+#include <cmath>
 #include <utility>
 
+#include "core/block.h"
 #include "core/index.h"
+#include "core/parallel.h"
 
 namespace voxplan {
+
+std::vector<Eigen::Vector3f> SurfaceCrossings(const TsdfVolume& volume, float min_weight,
+                                              size_t max_samples) {
+  const std::vector<BlockIndex> blocks = volume.SortedBlockIndices();
+  // The ray caster's test (core/raycast/sampler.h): weight 0 is never observed.
+  const uint32_t w_min = uint32_t(std::clamp(std::ceil(min_weight * kWeightScale), 1.f, 65536.f));
+  const auto observed = [w_min](const TsdfBlock& block, int i) {
+    return uint32_t(block.weight[i]) >= w_min;
+  };
+  // Which voxels of each block are crossings; the blocks are independent, so any split gives
+  // the same bits.
+  std::vector<std::bitset<kBlockVoxels>> crossing(blocks.size());
+  ParallelFor(blocks.size(), 64, [&](size_t begin, size_t end) {
+    for (size_t k = begin; k < end; ++k) {
+      const BlockIndex b = blocks[k];
+      const TsdfBlock& block = *volume.FindBlock(b);
+      const TsdfBlock* next[3] = {volume.FindBlock({b.x + 1, b.y, b.z}),
+                                  volume.FindBlock({b.x, b.y + 1, b.z}),
+                                  volume.FindBlock({b.x, b.y, b.z + 1})};
+      for (int i = 0; i < kBlockVoxels; ++i) {
+        if (!observed(block, i)) continue;
+        const VoxelIndex v = VoxelOfLinear(i);
+        const bool negative = block.tsdf[i] < 0;
+        for (int axis = 0; axis < 3; ++axis) {
+          int c[3] = {v.x, v.y, v.z};
+          const TsdfBlock* other = &block;
+          if (++c[axis] == kBlockSide) c[axis] = 0, other = next[axis];
+          const int j = LinearIndex(c[0], c[1], c[2]);
+          if (other && observed(*other, j) && (other->tsdf[j] < 0) != negative) {
+            crossing[k].set(size_t(i));
+            break;
+          }
+        }
+      }
+    }
+  });
+  size_t total = 0;
+  for (const auto& bits : crossing) total += bits.count();
+  const size_t stride =
+      max_samples == 0 ? 1 : std::max<size_t>(1, (total + max_samples - 1) / max_samples);
+  std::vector<Eigen::Vector3f> samples;
+  samples.reserve(total / stride + 1);
+  size_t n = 0;
+  for (size_t k = 0; k < blocks.size(); ++k) {
+    if (crossing[k].none()) continue;
+    for (int i = 0; i < kBlockVoxels; ++i)
+      if (crossing[k].test(size_t(i)) && n++ % stride == 0)
+        samples.push_back(
+            VoxelCenter(GlobalOf(blocks[k], VoxelOfLinear(i)), volume.voxel_size_m()));
+  }
+  return samples;
+}
 
 MapScene::MapScene(TsdfVolume volume, const MapSceneParams& params) : volume_(std::move(volume)) {
   params_.min_weight = params.min_weight;
@@ -20,6 +77,10 @@ MapScene::MapScene(TsdfVolume volume, const MapSceneParams& params) : volume_(st
     bounds_.extend(lo);
     bounds_.extend(Eigen::Vector3f(lo + Eigen::Vector3f::Constant(block_m)));
   });
+}
+
+std::vector<Eigen::Vector3f> MapScene::SurfaceSamples() const {
+  return SurfaceCrossings(volume_, params_.min_weight);
 }
 
 SurfaceImages MapScene::Render(const PinholeCamera& camera, const Pose3f& T_W_C) const {

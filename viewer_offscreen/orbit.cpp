@@ -13,6 +13,12 @@ constexpr float kFramingMargin = 1.05f;
 
 float Radians(float deg) { return deg * std::numbers::pi_v<float> / 180.0f; }
 
+// Tangents of the half-angles of `camera`'s view, narrowed by the framing margin.
+Eigen::Vector2f HalfViewTangents(const PinholeCamera& camera) {
+  return {0.5f * float(camera.width) / std::abs(camera.fx) / kFramingMargin,
+          0.5f * float(camera.height) / std::abs(camera.fy) / kFramingMargin};
+}
+
 }  // namespace
 
 std::vector<Pose3f> OrbitPoses(const Eigen::Vector3f& centre_W, float radius_m, float height_m,
@@ -49,6 +55,49 @@ OrbitFraming FrameBox(const Eigen::AlignedBox3f& box_W, const PinholeCamera& cam
   f.distance_m = kFramingMargin * r / std::sin(half_fov);
   f.radius_m = f.distance_m * std::cos(Radians(elevation_deg));
   f.height_m = f.distance_m * std::sin(Radians(elevation_deg));
+  return f;
+}
+
+OrbitFraming FrameSurface(const std::vector<Eigen::Vector3f>& samples_W,
+                          const PinholeCamera& camera, float elevation_deg, int n,
+                          const Eigen::Vector3f& up_W, float trim) {
+  if (samples_W.empty()) return FrameBox(Eigen::AlignedBox3f(), camera, elevation_deg);
+  // The index of the largest value left once a `trim` share (rounded down) is left out above.
+  const size_t m = samples_W.size();
+  const size_t k = m - 1 - size_t(double(std::clamp(trim, 0.0f, 0.5f)) * double(m - 1));
+  std::vector<float> values(m);
+  const auto upper_quantile = [&values, k] {
+    std::nth_element(values.begin(), values.begin() + ptrdiff_t(k), values.end());
+    return values[k];
+  };
+  Eigen::AlignedBox3f box;
+  for (int axis = 0; axis < 3; ++axis) {
+    for (size_t i = 0; i < m; ++i) values[i] = -samples_W[i][axis];
+    box.min()[axis] = -upper_quantile();
+    for (size_t i = 0; i < m; ++i) values[i] = samples_W[i][axis];
+    box.max()[axis] = upper_quantile();
+  }
+  OrbitFraming f;
+  f.centre_W = box.center();
+  f.bound_radius_m = 0.5f * box.diagonal().norm();
+  // The views' rotations (the same at any distance). A sample q (camera axes, relative to the
+  // centre) is in view from distance d when d + q.z >= max(|q.x| / tx, |q.y| / ty, 5 cm).
+  const float e = Radians(elevation_deg);
+  const std::vector<Pose3f> views =
+      OrbitPoses(f.centre_W, std::cos(e), std::sin(e), std::max(n, 1), up_W);
+  const Eigen::Vector2f t = HalfViewTangents(camera);
+  float distance = 1e-3f;
+  for (const Pose3f& view : views) {
+    const Eigen::Matrix3f R_C_W = view.linear().transpose();
+    for (size_t i = 0; i < m; ++i) {
+      const Eigen::Vector3f q = R_C_W * (samples_W[i] - f.centre_W);
+      values[i] = std::max({std::abs(q.x()) / t.x(), std::abs(q.y()) / t.y(), 0.05f}) - q.z();
+    }
+    distance = std::max(distance, upper_quantile());
+  }
+  f.distance_m = distance;
+  f.radius_m = distance * std::cos(e);
+  f.height_m = distance * std::sin(e);
   return f;
 }
 

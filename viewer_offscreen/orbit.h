@@ -28,6 +28,19 @@ struct OrbitFraming {
 OrbitFraming FrameBox(const Eigen::AlignedBox3f& box_W, const PinholeCamera& camera,
                       float elevation_deg = 35.0f);
 
+// An orbit framed on the surface itself: `samples_W`, points spread over it by area (SurfaceScene's
+// SurfaceSamples). Centred on the box between the `trim` and 1 - `trim` quantiles of the samples
+// along each world axis; as near as keeps all but a `trim` share of the samples inside the image
+// of `camera` (with FrameBox's margin, at least 5 cm in front) in every one of the n views
+// OrbitPoses places about `up_W` at `elevation_deg`. So what is drawn fills the views however
+// little of its box it covers (a partly seen room), and a few stray bits far out (noise: under a
+// `trim` share of the surface) neither move nor shrink it. bound_radius_m: half the diagonal of
+// that box. No samples: FrameBox of an empty box.
+OrbitFraming FrameSurface(const std::vector<Eigen::Vector3f>& samples_W,
+                          const PinholeCamera& camera, float elevation_deg, int n,
+                          const Eigen::Vector3f& up_W = Eigen::Vector3f::UnitZ(),
+                          float trim = 0.01f);
+
 // A camera of width x height pixels with a horizontal field of view, square pixels, principal
 // point at the image centre.
 PinholeCamera CameraFromFov(int width, int height, float horizontal_fov_deg);

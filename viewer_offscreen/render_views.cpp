@@ -1,5 +1,5 @@
-// RenderViews: poses (given or an orbit), one depth range per turntable, render, count hits,
-// shade.
+// RenderViews: poses (given or an orbit framed on the surface or the bounds), one depth range
+// per turntable, render, count hits, shade.
 #include "viewer_offscreen/render_views.h"
 
 #include <algorithm>
@@ -86,18 +86,32 @@ Result<RenderedViews> RenderViews(const SurfaceScene& scene, const RenderViewsPa
   PinholeCamera camera =
       params.camera ? *params.camera : CameraFromFov(params.width, params.height, params.fov_deg);
   views.bounds_W = scene.Bounds();
+  const bool orbit = !params.T_W_C && params.poses.empty();
+  // An orbit frames the surface where the scene gives samples of it (a map), else its box.
+  const std::vector<Eigen::Vector3f> samples =
+      orbit ? scene.SurfaceSamples() : std::vector<Eigen::Vector3f>();
+  views.surface_framed = !samples.empty();
+  const auto frame = [&](float elevation_deg) {
+    OrbitFraming f = samples.empty() ? FrameBox(views.bounds_W, camera, elevation_deg)
+                                     : FrameSurface(samples, camera, elevation_deg,
+                                                    std::max(params.orbit_views, 1), params.up_W);
+    if (params.orbit_radius_m) f.radius_m = *params.orbit_radius_m;  // given values win
+    return f;
+  };
   OrbitFraming& framing = views.framing;
-  framing = FrameBox(views.bounds_W, camera, params.orbit_elevation_deg);
-  if (params.orbit_radius_m) framing.radius_m = *params.orbit_radius_m;
+  framing = frame(params.orbit_elevation_deg);
   if (params.orbit_height_m) {
     framing.height_m = *params.orbit_height_m;
-  } else if (params.choose_side && !params.T_W_C && params.poses.empty()) {
-    OrbitFraming below = framing;
-    below.height_m = -framing.height_m;
-    // Below only when it sees clearly more: from above is how rooms are drawn.
-    if (PreviewHits(scene, params, camera, below) >
+  } else if (params.choose_side && orbit) {
+    // The orbit mirrored below the centre, at the same distance, so the previews compare how
+    // much of the surface each side sees. Below only when it sees clearly more: from above is
+    // how rooms are drawn.
+    OrbitFraming mirrored = framing;
+    mirrored.height_m = -framing.height_m;
+    if (PreviewHits(scene, params, camera, mirrored) >
         1.5 * PreviewHits(scene, params, camera, framing)) {
-      framing = below;
+      // Framed for the views from there (for a box, the mirrored orbit itself).
+      framing = samples.empty() ? mirrored : frame(-params.orbit_elevation_deg);
       views.from_below = true;
     }
   }

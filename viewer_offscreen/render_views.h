@@ -1,7 +1,7 @@
 #pragma once
 // Shaded views of a SurfaceScene: from given poses (one, or a dataset's frames) or a turntable
-// framed on its bounds, all kept in memory so a caller writes files only once every view has
-// rendered. Pictures are upright for a y-flipped camera too (UprightCamera).
+// framed on its surface (or bounds), all kept in memory so a caller writes files only once every
+// view has rendered. Pictures are upright for a y-flipped camera too (UprightCamera).
 #include <Eigen/Geometry>
 #include <functional>
 #include <optional>
@@ -31,10 +31,12 @@ struct RenderViewsParams {
   std::vector<Pose3f> poses;
   int orbit_views = 1;                              // 0 renders one view too
   Eigen::Vector3f up_W = Eigen::Vector3f::UnitZ();  // the orbit's axis; upright pictures' up
-  std::optional<float> orbit_radius_m;  // across the up axis; unset: framed on the bounds
-  std::optional<float> orbit_height_m;  // along the up axis; unset: framed on the bounds
+  // An orbit is framed on the scene's surface samples (FrameSurface: what is drawn fills the
+  // views) where it gives some (a map), else on its bounds (FrameBox: the whole box in view).
+  std::optional<float> orbit_radius_m;  // across the up axis; unset: framed
+  std::optional<float> orbit_height_m;  // along the up axis; unset: framed
   float orbit_elevation_deg = 35.0f;    // of the framing
-  // An orbit framed on the bounds (no orbit height given) goes below the centre when a small
+  // A framed orbit (no orbit height given) goes below the centre, framed from there, when a small
   // preview of its views sees over 1.5 times the surface from there as from above: a room fused
   // from inside shows its inside from the side its floor (or ceiling) faces.
   bool choose_side = false;
@@ -47,9 +49,10 @@ struct RenderViewsParams {
 };
 
 struct RenderedViews {
-  Eigen::AlignedBox3f bounds_W;
-  OrbitFraming framing;       // the orbit (its centre is reported with a pose too)
-  std::vector<Pose3f> T_W_C;  // one per image
+  Eigen::AlignedBox3f bounds_W;  // the scene's Bounds()
+  OrbitFraming framing;          // the orbit (its centre is reported with a pose too)
+  bool surface_framed = false;   // the orbit was framed on the scene's surface samples
+  std::vector<Pose3f> T_W_C;     // one per image
   std::vector<ColorImage> images;
   PinholeCamera camera;       // what they were rendered with (UprightCamera's)
   bool rows_flipped = false;  // a y-flipped camera rendered with |fy| (UprightCamera)

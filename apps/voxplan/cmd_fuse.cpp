@@ -72,6 +72,8 @@ nlohmann::json FuseStats(const FuseOptions& o, const DatasetInfo& info,
   j["kernel"] = KernelName(ResolveKernel(params.kernel));
   j["camera"] = CameraJson(info.camera);
   j["depth_scale"] = info.depth_scale;
+  j["depth_encoding"] = OrNull(info.depth_encoding);
+  j["depth_scale_applies"] = !info.depth_metres;
   j["depth_median_first_frames_m"] = RoundTo(report.first_frames_median_depth_m, 4);
   j["depth_scale_suggested"] = report.suggested_depth_scale > 0.0
                                    ? nlohmann::json(report.suggested_depth_scale)
@@ -125,6 +127,17 @@ FuseParams FuseParamsOf(const FuseOptions& o) {
   return fuse;
 }
 
+int DatasetOptionsOf(const FuseOptions& o, DatasetOptions* options) {
+  if (!o.intrinsics.empty()) {
+    Result<PinholeCamera> camera = ParseIntrinsics(o.intrinsics);
+    if (!camera.ok()) return Fail(camera.status().message(), kExitUsage);
+    options->intrinsics = *camera;
+  }
+  if (o.depth_scale > 0.0) options->depth_scale = o.depth_scale;
+  options->max_pose_gap_s = o.max_pose_gap_s;
+  return kExitOk;
+}
+
 VolumeParams VolumeParamsOf(const FuseOptions& o) {
   return {float(o.voxel_size_m), float(o.trunc_m), MemoryBudgetBytes(o.memory)};
 }
@@ -156,14 +169,7 @@ int RunFuse(const FuseOptions& o) {
   if (!world.ok()) return Fail(world.status().message());
   if ((*world)->size() > 1 || o.checkpoint_every > 0 || o.resume) return RunFuseSharded(o, **world);
   DatasetOptions dataset_options;
-  if (!o.intrinsics.empty()) {
-    Result<PinholeCamera> camera = ParseIntrinsics(o.intrinsics);
-    if (!camera.ok()) return Fail(camera.status().message(), kExitUsage);
-    dataset_options.intrinsics = *camera;
-  }
-  if (o.depth_scale > 0.0) dataset_options.depth_scale = o.depth_scale;
-  dataset_options.max_pose_gap_s = o.max_pose_gap_s;
-
+  if (int code = DatasetOptionsOf(o, &dataset_options); code != kExitOk) return code;
   ThreadLimit thread_limit(o.threads);
   OpenedDataset opened;
   if (int code = OpenDatasetInput(o.in, dataset_options, &opened); code != kExitOk) return code;

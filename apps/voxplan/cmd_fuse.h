@@ -42,6 +42,9 @@ nlohmann::json FuseStats(const FuseOptions& o, const DatasetInfo& info,
 // The run's fusion and volume parameters, from the options.
 FuseParams FuseParamsOf(const FuseOptions& o);
 VolumeParams VolumeParamsOf(const FuseOptions& o);
+// The dataset options (--intrinsics, --depth-scale, --max-pose-gap) into *options: kExitOk, or
+// the usage exit code after printing why.
+int DatasetOptionsOf(const FuseOptions& o, DatasetOptions* options);
 // No output may be another output or one of the dataset's files; the exit code (printed why).
 int RefuseCollisions(const FuseOptions& o, const Dataset& dataset);
 

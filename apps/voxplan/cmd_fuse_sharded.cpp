@@ -46,9 +46,13 @@ nlohmann::json Fingerprint(const FuseOptions& o, const DatasetInfo& info,
           {"camera", CameraJson(info.camera)}};
 }
 
-// A one-line message for a status; on ranks other than 0 prefixed with the rank.
-int FailOnRank(Communicator& comm, const Status& s, bool root_reports_only) {
-  if (comm.is_root() || !root_reports_only) {
+// A failure's message: rank 0 prints it, another rank only its own (not "rank R stopped", which
+// rank 0 prints), prefixed with its rank. The exit code is the same on every rank.
+int FailOnRank(Communicator& comm, const Status& s) {
+  // A stop comes from rank 0 (it polls the signals): the others follow it quietly.
+  const bool own = s.message().find(kOtherRankStopped) == std::string::npos &&
+                   s.code() != StatusCode::kCancelled;
+  if (comm.is_root() || own) {
     const std::string prefix = comm.is_root() ? "" : "rank " + std::to_string(comm.rank()) + ": ";
     if (s.code() == StatusCode::kCancelled) return Interrupted(prefix + s.message());
     return Fail(prefix + s.message());
@@ -77,13 +81,7 @@ int RunFuseSharded(const FuseOptions& o, Communicator& comm) {
         "without checkpoints",
         kExitUsage);
   DatasetOptions dataset_options;
-  if (!o.intrinsics.empty()) {
-    Result<PinholeCamera> camera = ParseIntrinsics(o.intrinsics);
-    if (!camera.ok()) return Fail(camera.status().message(), kExitUsage);
-    dataset_options.intrinsics = *camera;
-  }
-  if (o.depth_scale > 0.0) dataset_options.depth_scale = o.depth_scale;
-  dataset_options.max_pose_gap_s = o.max_pose_gap_s;
+  if (int code = DatasetOptionsOf(o, &dataset_options); code != kExitOk) return code;
   ThreadLimit thread_limit(o.threads);
 
   // Rank 0 opens and checks the dataset; the others learn what it found.
@@ -124,9 +122,11 @@ int RunFuseSharded(const FuseOptions& o, Communicator& comm) {
   FuseObserver observer;
   if (progress) observer.progress = [&](size_t done, size_t) { progress->Update(done); };
   observer.warning = [&](const std::string& message) {
+    // Every rank sees the same frames, so their skip and depth warnings are rank 0's; only the
+    // memory budget is a rank's own.
     if (progress)
       progress->Warn(message);
-    else
+    else if (message.rfind("memory budget", 0) == 0)
       std::cerr << "rank " << comm.rank() << ": warning: " << message << "\n";
   };
   const StopPolling polling;  // rank 0 decides when to stop; the others follow
@@ -141,7 +141,7 @@ int RunFuseSharded(const FuseOptions& o, Communicator& comm) {
         !o.map_path.empty() && o.checkpoint_every > 0)
       s = Cancelled(s.message() + "; the last checkpoint is " + o.map_path +
                     " (continue with --resume)");
-    return FailOnRank(comm, s, /*root_reports_only=*/true);
+    return FailOnRank(comm, s);
   }
   const FuseReport& report = fused->report;
   if (report.frames.empty()) {
@@ -174,7 +174,7 @@ int RunFuseSharded(const FuseOptions& o, Communicator& comm) {
           std::filesystem::remove(ShardFilePath(o.map_path, shard.file), ec);
         }
     }
-    if (!s.ok()) return FailOnRank(comm, s, /*root_reports_only=*/true);
+    if (!s.ok()) return FailOnRank(comm, s);
   }
   Mesh mesh;
   double mesh_ms = 0.0;
@@ -183,12 +183,12 @@ int RunFuseSharded(const FuseOptions& o, Communicator& comm) {
     MeshParams mesh_params;
     mesh_params.min_weight = float(o.mesh_min_weight);
     Result<Mesh> meshed = ExtractMeshSharded(comm, local, mesh_params);
-    if (!meshed.ok()) return FailOnRank(comm, meshed.status(), false);
+    if (!meshed.ok()) return FailOnRank(comm, meshed.status());
     mesh = std::move(*meshed);
     mesh_ms = mesh_clock.ElapsedMs();
   }
   Result<std::vector<RankFigures>> figures = GatherRankFigures(comm, local);
-  if (!figures.ok()) return FailOnRank(comm, figures.status(), false);
+  if (!figures.ok()) return FailOnRank(comm, figures.status());
   if (!comm.is_root()) return AgreeOnExit(comm, kExitOk);
 
   // Rank 0: the other outputs, together, and the stats.
@@ -211,12 +211,13 @@ int RunFuseSharded(const FuseOptions& o, Communicator& comm) {
     nlohmann::json j =
         FuseStats(o, info, params.fuse.integrate, report, local, mesh, mesh_ms, octomap);
     // The map over all ranks, and each rank's part.
-    uint64_t blocks = 0, bytes = 0;
+    uint64_t blocks = 0, bytes = 0, refused = 0;
     nlohmann::json rank_blocks = nlohmann::json::array(), rank_mb = nlohmann::json::array(),
                    rank_rss = nlohmann::json::array();
     for (const RankFigures& f : *figures) {
       blocks += f.blocks;
       bytes += f.map_bytes;
+      refused += f.blocks_refused;
       rank_blocks.push_back(f.blocks);
       rank_mb.push_back(RoundTo(Mib(f.map_bytes), 3));
       rank_rss.push_back(f.peak_rss_mb);
@@ -227,6 +228,7 @@ int RunFuseSharded(const FuseOptions& o, Communicator& comm) {
     j["blocks"] = blocks;
     j["voxels"] = blocks * kBlockVoxels;
     j["map_mb"] = RoundTo(Mib(bytes), 3);
+    j["blocks_refused"] = refused;  // by every rank's budget (frames_over_budget is rank 0's)
     j["rank_blocks"] = rank_blocks;
     j["rank_map_mb"] = rank_mb;
     j["rank_peak_rss_mb"] = rank_rss;

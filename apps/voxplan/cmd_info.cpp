@@ -43,7 +43,14 @@ int DatasetInfoCommand(const InfoOptions& o) {
   std::fprintf(stderr, "image       %d x %d\n", c.width, c.height);
   std::fprintf(stderr, "intrinsics  fx %g  fy %g  cx %g  cy %g  (%s)\n", c.fx, c.fy, c.cx, c.cy,
                info.intrinsics_source.c_str());
-  std::fprintf(stderr, "depth scale %g units per metre\n", info.depth_scale);
+  if (info.depth_metres)
+    std::fprintf(stderr, "depth       %s, metres (the depth scale does not apply)\n",
+                 info.depth_encoding.c_str());
+  else if (info.depth_encoding.empty())
+    std::fprintf(stderr, "depth scale %g units per metre\n", info.depth_scale);
+  else
+    std::fprintf(stderr, "depth scale %g units per metre (%s)\n", info.depth_scale,
+                 info.depth_encoding.c_str());
   std::fprintf(stderr, "poses       %s\n", info.pose_source.c_str());
   std::fprintf(stderr, "up axis     %s (%s)\n", WorldUpName(info.up), info.up_source.c_str());
   if (info.frames_bad_pose > 0)
@@ -66,6 +73,9 @@ int DatasetInfoCommand(const InfoOptions& o) {
   j["camera"] = CameraJson(c);
   j["intrinsics_source"] = info.intrinsics_source;
   j["depth_scale"] = info.depth_scale;
+  j["depth_encoding"] =
+      info.depth_encoding.empty() ? nlohmann::json(nullptr) : nlohmann::json(info.depth_encoding);
+  j["depth_scale_applies"] = !info.depth_metres;
   j["pose_source"] = info.pose_source;
   j["up"] = WorldUpName(info.up);
   j["up_source"] = info.up_source;

@@ -16,8 +16,8 @@
 #include "io/dataset.h"
 #include "io/image_io.h"
 #include "io/map_io.h"
-#include "io/sharded_map.h"
 #include "io/mesh_io.h"
+#include "io/sharded_map.h"
 #include "io/world_up.h"
 #include "sim/mesh_scene.h"
 #include "viewer_offscreen/render_views.h"
@@ -42,7 +42,7 @@ struct RenderOptions {
   std::string up = "auto";    // the scene's up axis; auto: the map's recorded one, else z
   std::string intrinsics;     // "fx,fy,cx,cy" of the views' camera (size from --size)
   DatasetInput dataset;       // --dataset: views at its frames' poses, with its camera
-  double orbit_radius_m = 0;  // 0: from the bounds
+  double orbit_radius_m = 0;  // 0: framed (RenderViews)
   double orbit_height_m = 0;
   bool orbit_height_set = false;
   double near_m = 0.0;          // maps: rays start this far out (cuts away near walls); 0: 0.01 m
@@ -248,6 +248,8 @@ int RunRender(const RenderOptions& o) {
   if (o.pose.empty() && !at_dataset) {
     j["orbit_radius_m"] = RoundTo(views->framing.radius_m, 6);
     j["orbit_height_m"] = RoundTo(views->framing.height_m, 6);
+    // What the orbit was framed on: a map's surface (its zero crossings) or the bounds (a mesh).
+    j["framed_on"] = views->surface_framed ? "surface" : "bounds";
   }
   j["hit_fraction"] = RoundTo(views->hit_fraction, 6);
   j["dollhouse"] = params.choose_side;
@@ -367,7 +369,8 @@ Command AddRenderCommand(CLI::App& app) {
       ->check(CLI::IsMember({"auto", "x", "y", "z", "+x", "+y", "+z", "-x", "-y", "-z"}))
       ->capture_default_str();
   sub->add_option("--orbit-radius", o->orbit_radius_m,
-                  "Orbit: distance from the centre across the up axis (m; default from bounds)")
+                  "Orbit: distance from the centre across the up axis (m; default: framed on a "
+                  "map's surface, a mesh's bounds)")
       ->check(InRange(1e-3, 1e4, "m"));
   sub->add_option_function<double>(
          "--orbit-height",
@@ -375,7 +378,8 @@ Command AddRenderCommand(CLI::App& app) {
            o->orbit_height_m = h;
            o->orbit_height_set = true;
          },
-         "Orbit: height above the centre along the up axis (m; default from bounds)")
+         "Orbit: height above the centre along the up axis (m; default: framed on a map's "
+         "surface, a mesh's bounds)")
       ->check(InRange(-1e4, 1e4, "m"));
   sub->add_option("--near", o->near_m,
                   "Maps: start rays this far from the camera (m), to cut away near walls")

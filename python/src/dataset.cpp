@@ -262,6 +262,8 @@ struct PyFuseResult {
   FuseParams params;
   FrameListParams list;  // camera and parameters, for the frame list
   std::string dataset, format;
+  std::string depth_encoding;  // DatasetInfo's: "16-bit PNG", "32-bit float TIFF", ...
+  bool depth_metres = false;   // float depth: depth_scale does not apply
   std::string on_memory_limit;
   int threads = 0;
   std::vector<std::string> warnings;
@@ -316,6 +318,9 @@ py::dict FuseStats(const PyFuseResult& s) {
   j["threads"] = s.threads;
   j["kernel"] = KernelName(ResolveKernel(s.params.integrate.kernel));
   j["depth_scale"] = s.list.depth_scale;
+  j["depth_encoding"] =
+      s.depth_encoding.empty() ? py::object(py::none()) : py::object(py::str(s.depth_encoding));
+  j["depth_scale_applies"] = !s.depth_metres;
   j["depth_median_first_frames_m"] = RoundTo(r.first_frames_median_depth_m, 4);
   j["depth_scale_suggested"] =
       r.suggested_depth_scale > 0.0 ? py::object(py::float_(r.suggested_depth_scale)) : py::none();
@@ -446,6 +451,8 @@ std::unique_ptr<PyFuseResult> Fuse(const py::object& dataset_in, double voxel_si
   result->list = {info.camera, info.depth_scale, voxel_size, trunc, min_depth, max_depth};
   result->dataset = ds.path;
   result->format = DatasetFormatName(info.format);
+  result->depth_encoding = info.depth_encoding;
+  result->depth_metres = info.depth_metres;
   result->on_memory_limit = on_memory_limit;
   PythonObserver python(progress);
   const FuseObserver observer = python.Observer();
@@ -583,7 +590,17 @@ voxplan.open_dataset.
                              [](const PyDataset& d) { return d.dataset->info().camera.height; })
       .def_property_readonly(
           "depth_scale", [](const PyDataset& d) { return d.dataset->info().depth_scale; },
-          "depth units per metre of the raw images")
+          "depth units per metre of the raw 16-bit images (float TIFF / EXR depth is metres: "
+          "see depth_encoding)")
+      .def_property_readonly(
+          "depth_encoding",
+          [](const PyDataset& d) -> py::object {
+            const std::string& e = d.dataset->info().depth_encoding;
+            return e.empty() ? py::object(py::none()) : py::object(py::str(e));
+          },
+          "what the depth files hold: '16-bit PNG', '16-bit TIFF' (units of 1 / depth_scale), "
+          "'32-bit float TIFF', '32-bit float EXR', '16-bit float EXR' (metres: depth_scale "
+          "does not apply); None for the formats in one file (.sens, .bag)")
       .def_property_readonly("has_color",
                              [](const PyDataset& d) { return d.dataset->info().has_color; })
       .def_property_readonly("intrinsics_source",

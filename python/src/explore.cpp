@@ -4,10 +4,13 @@
 #include <dlfcn.h>
 #include <pybind11/stl.h>
 
+#include <cmath>
 #include <cstdlib>
 #include <filesystem>
 #include <optional>
+#include <sstream>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "core/bounds.h"
@@ -78,6 +81,57 @@ ExploreParams::Poses ParsePoses(const std::string& poses) {
   throw py::value_error("poses must be 'truth' or 'tracked', got '" + poses + "'");
 }
 
+std::string Num(double v) {
+  std::ostringstream s;
+  s << v;
+  return s.str();
+}
+
+// `value` within [lo, hi] (the CLI's bounds, apps/voxplan/cmd_explore.cpp), else ValueError
+// naming the argument and the range.
+void CheckIn(const char* name, double value, double lo, double hi, const char* unit = "") {
+  if (Status s = bounds::CheckRange(name, value, lo, hi, unit); !s.ok())
+    throw py::value_error(s.message());
+}
+
+// The camera options' limits, as `voxplan explore` checks them (exclusive): RobotParams' field-
+// of-view bounds, and the near depth frames are fused from.
+constexpr double kMinFovDeg = 1.0, kMaxFovDeg = 179.0;
+constexpr double kMinRangeM = 0.1;
+// The CLI's positive options (planning interval, fuse steps, ...).
+constexpr double kPositiveMin = 1e-6, kPositiveMax = 1e6;
+// --floor-z's bound (apps/voxplan/cli_common.h kMaxFloorZ_m).
+constexpr double kMaxFloorZ_m = 100.0;
+
+// The scene frame options of `voxplan explore` (--up, --scale, --floor-z: apps/voxplan/
+// cli_common.cpp SceneLoad), for scene files.
+SceneLoadOptions SceneFrame(const std::string& up, double scale, const py::object& floor_z) {
+  SceneLoadOptions load;
+  if (up == "z" || up == "Z") {
+    load.up = UpAxis::kZ;
+  } else if (up == "y" || up == "Y") {
+    load.up = UpAxis::kY;  // a Y-up file rotated into the Z-up world
+  } else {
+    throw py::value_error("up must be 'z' or 'y', got '" + up + "'");
+  }
+  CheckIn("scale", scale, kPositiveMin, kPositiveMax);
+  load.scale = float(scale);
+  if (py::isinstance<py::str>(floor_z)) {
+    const std::string text = floor_z.cast<std::string>();
+    if (text != "auto")
+      throw py::value_error("floor_z must be 'auto' or a height in metres within +-" +
+                            Num(kMaxFloorZ_m) + ", got '" + text + "'");
+    load.detect_floor = true;
+  } else {
+    const double z = floor_z.cast<double>();
+    if (!(std::abs(z) <= kMaxFloorZ_m))
+      throw py::value_error("floor_z must be 'auto' or a height in metres within +-" +
+                            Num(kMaxFloorZ_m) + ", got " + Num(z));
+    load.floor_z_m = float(z);
+  }
+  return load;
+}
+
 std::unique_ptr<PyExploreResult> Explore(
     const std::string& scene, const std::string& planner_name, const py::object& planner_config,
     int robots, uint64_t seed, double max_time, const py::object& out_dir_in,
@@ -85,7 +139,12 @@ std::unique_ptr<PyExploreResult> Explore(
     int width, int height, bool noise, bool labels, bool detector_noise, bool color,
     const std::string& poses, const py::object& profile, double planning_interval,
     double plan_budget, double eval_samples, std::optional<int> threads,
-    std::optional<uint64_t> max_memory, const py::object& progress) {
+    std::optional<uint64_t> max_memory, const py::object& progress, const py::object& robot_config,
+    std::optional<double> fov_deg, std::optional<double> max_range, bool clear_beyond_range,
+    const py::object& odometry_noise, bool planner_picture, double planner_hard_limit,
+    double planner_hard_limit_min, std::optional<double> capture_hz, double fuse_step,
+    double fuse_step_deg, double progress_interval, const std::string& up, double scale,
+    const py::object& floor_z) {
   const py::module_ json = py::module_::import("json");
   std::string config_json = "{}";
   if (py::isinstance<py::str>(planner_config)) {
@@ -101,12 +160,64 @@ std::unique_ptr<PyExploreResult> Explore(
   if (robots < 1 || robots > 64) throw py::value_error("robots must be in [1, 64]");
   if (!(max_time > 0.0)) throw py::value_error("max_time must be > 0 seconds");
   if (threads) CheckThreads(*threads);
+  // The CLI's refusals before any work (apps/voxplan/cmd_explore.cpp CheckUsage), by argument.
+  if (fov_deg && !(*fov_deg > kMinFovDeg && *fov_deg < kMaxFovDeg))
+    throw py::value_error("fov_deg must lie strictly between " + Num(kMinFovDeg) + " and " +
+                          Num(kMaxFovDeg) + " degrees, got " + Num(*fov_deg));
+  if (max_range && !(*max_range > kMinRangeM && *max_range <= bounds::kDepthMaxM))
+    throw py::value_error("max_range must be a finite number of metres above " + Num(kMinRangeM) +
+                          " and at most " + Num(bounds::kDepthMaxM) + ", got " + Num(*max_range));
+  if (capture_hz && !(*capture_hz >= 0.0 && *capture_hz <= kMaxCaptureHz))
+    throw py::value_error("capture_hz must be 0 (capture by displacement) or a rate up to " +
+                          Num(kMaxCaptureHz) + " frames per second, got " + Num(*capture_hz));
+  if (!(planner_hard_limit >= 1.0 && std::isfinite(planner_hard_limit)))
+    throw py::value_error("planner_hard_limit must be a factor >= 1 of plan_budget, got " +
+                          Num(planner_hard_limit));
+  if (!(planner_hard_limit_min > 0.0 && std::isfinite(planner_hard_limit_min)))
+    throw py::value_error("planner_hard_limit_min must be a finite number of seconds > 0, got " +
+                          Num(planner_hard_limit_min));
+  std::optional<std::pair<double, double>> odometry;
+  if (!odometry_noise.is_none()) {
+    const auto tr = odometry_noise.cast<std::vector<double>>();
+    if (tr.size() != 2)
+      throw py::value_error("odometry_noise must be (translation per metre, rotation per radian)");
+    CheckIn("odometry_noise translation (per metre moved)", tr[0], 0.0, 1.0);
+    CheckIn("odometry_noise rotation (per radian turned)", tr[1], 0.0, 1.0);
+    odometry.emplace(tr[0], tr[1]);
+  }
+  CheckIn("planning_interval", planning_interval, kPositiveMin, kPositiveMax, "s");
+  CheckIn("plan_budget", plan_budget, kPositiveMin, kPositiveMax, "s");
+  CheckIn("eval_samples", eval_samples, kPositiveMin, kPositiveMax, "per m^2");
+  CheckIn("fuse_step", fuse_step, kPositiveMin, kPositiveMax, "m");
+  CheckIn("fuse_step_deg", fuse_step_deg, kPositiveMin, kPositiveMax, "degrees");
+  CheckIn("progress_interval", progress_interval, kPositiveMin, kPositiveMax, "s");
+  const PlannerLimits limits{.budget_factor = planner_hard_limit,
+                             .min_s = planner_hard_limit_min,
+                             .unbudgeted_s = PlannerLimits{}.unbudgeted_s};
 
   ExploreRunParams run;
   run.scene = scene;
+  run.scene_load = SceneFrame(up, scale, floor_z);
   run.robots = robots;
   ExploreParams& params = run.explore;
+  // As `voxplan explore` orders them (cmd_explore.cpp RunParams): the profile, then the robot
+  // file over its robot, then the arguments; the camera ones only when given (None keeps the
+  // profile's, the file's, or the built-in robot's).
   if (!profile.is_none()) ThrowIfError(ApplyExploreProfile(profile.cast<std::string>(), &params));
+  if (!robot_config.is_none())
+    params.robot = ValueOrThrow(ReadRobotConfig(PathString(robot_config), params.robot));
+  if (fov_deg) params.robot.explorer.horizontal_fov_deg = float(*fov_deg);
+  if (max_range) params.robot.explorer.max_range_m = float(*max_range);
+  if (capture_hz)
+    params.robot.explorer.capture_hz = params.robot.reconstructor.capture_hz = float(*capture_hz);
+  if (odometry) {
+    params.odometry.translation_per_m = float(odometry->first);
+    params.odometry.rotation_per_rad = float(odometry->second);
+  }
+  params.clear_beyond_range = clear_beyond_range;
+  params.keep_planner_drawings = planner_picture;
+  params.trigger = {float(fuse_step), float(fuse_step_deg)};
+  params.progress_interval_s = progress_interval;
   params.seed = seed;
   params.max_time_s = max_time;
   params.voxel_size_m = float(voxel_size);
@@ -172,7 +283,7 @@ std::unique_ptr<PyExploreResult> Explore(
                                                                 {.config_json = config_json,
                                                                  .seed = seed,
                                                                  .search_path = PlannerSearchPath(),
-                                                                 .limits = {}},
+                                                                 .limits = limits},
                                                                 &load_fault);
     if (!loaded.ok()) {
       if (!load_fault.call.empty())
@@ -288,16 +399,41 @@ reconstruction map when one was asked for), and the output folder.
         py::arg("color") = true, py::arg("poses") = "truth", py::arg("profile") = py::none(),
         py::arg("planning_interval") = 15.0, py::arg("plan_budget") = 1.0,
         py::arg("eval_samples") = 100.0, py::arg("threads") = py::none(),
-        py::arg("max_memory") = py::none(), py::arg("progress") = py::none(), R"doc(
+        py::arg("max_memory") = py::none(), py::arg("progress") = py::none(),
+        py::arg("robot_config") = py::none(), py::arg("fov_deg") = py::none(),
+        py::arg("max_range") = py::none(), py::arg("clear_beyond_range") = true,
+        py::arg("odometry_noise") = py::none(), py::arg("planner_picture") = false,
+        py::arg("planner_hard_limit") = PlannerLimits{}.budget_factor,
+        py::arg("planner_hard_limit_min") = PlannerLimits{}.min_s,
+        py::arg("capture_hz") = py::none(), py::arg("fuse_step") = 0.25,
+        py::arg("fuse_step_deg") = 15.0,
+        py::arg("progress_interval") = ExploreParams{}.progress_interval_s, py::arg("up") = "z",
+        py::arg("scale") = 1.0, py::arg("floor_z") = 0.0, R"doc(
 Runs one exploration experiment as `voxplan explore` does: scene 'apartment:size=S|M|L|XL|R,
 seed=N' (generated) or a scene file; planner a plugin name (see planners()) or a path to a .so,
 with planner_config a dict or JSON text; simulated robots drive the planner's tasks for at most
 max_time simulated seconds, their frames fused into a voxel_size map; then the mesh is scored.
-The defaults are the CLI's. The artefacts (mesh.ply, metrics.json, run_log.csv, ...) go to
-out_dir (created; its parent must exist), or to a temporary folder removed afterwards.
-progress(dict) gets t_s, frames_fused, coverage, distance_total_m, plan_calls; an exception
-it raises is raised when the run ends. The GIL is released while the run goes on.
-A planner that crashes or hangs ends the run (terminated, planner_fault) with a warning.)doc");
+Every option of `voxplan explore` is an argument here, with its default and bounds (a value out
+of them raises ValueError naming the argument and the range):
+  scene files: up 'z' or 'y' (a Y-up file), scale to metres, floor_z the file's floor height
+  (metres after up and scale; 'auto': detected) the world is moved down by;
+  profile ('guo2022', 'xu2017'), then robot_config (a robot JSON file, explore/robot_config.h)
+  over its robot, then fov_deg, max_range (metres) and capture_hz (frames per second; 0: by
+  displacement) of the explorer camera: None keeps the profile's, the file's or the built-in
+  robot's (90 degrees, 5 m, 0);
+  clear_beyond_range: depth past max_range clears the free space in front of it;
+  odometry_noise (T, R): with poses='tracked', 1 sigma per metre moved and per radian turned
+  (default 0.02, 0.01);
+  fuse_step (m), fuse_step_deg: camera travel and turn between fused frames;
+  planner_picture: also write planner.png (the planner's debug drawings over the floor);
+  planner_hard_limit, planner_hard_limit_min: a plan call running that many times plan_budget
+  (at least that many seconds) is given up, the run ending as 'planner_hung';
+  progress_interval: simulated seconds between progress(dict) calls.
+The artefacts (mesh.ply, metrics.json, run_log.csv, robot.json, ...) go to out_dir (created; its
+parent must exist), or to a temporary folder removed afterwards. progress(dict) gets t_s,
+frames_fused, coverage, distance_total_m, plan_calls; an exception it raises is raised when the
+run ends. The GIL is released while the run goes on. A planner that crashes or hangs ends the
+run (terminated, planner_fault) with a warning.)doc");
 
   m.def(
       "planners", [] { return AvailablePlanners(PlannerSearchPath()); },

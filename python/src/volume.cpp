@@ -16,8 +16,8 @@
 #include "eval/eval_mesh.h"
 #include "fusion/mesh_extract.h"
 #include "io/map_io.h"
-#include "io/sharded_map.h"
 #include "io/mesh_io.h"
+#include "io/sharded_map.h"
 #include "python/src/objects.h"
 
 namespace voxplan::python {

@@ -236,7 +236,12 @@ class Dataset:
     @property
     def height(self) -> int: ...
     @property
-    def depth_scale(self) -> float: ...
+    def depth_scale(self) -> float:
+        """Depth units per metre of the raw 16-bit images (not of float depth files)."""
+    @property
+    def depth_encoding(self) -> str | None:
+        """'16-bit PNG', '16-bit TIFF', '32-bit float TIFF', '32-bit float EXR', ...: float
+        depth is metres (depth_scale does not apply); None for .sens and .bag datasets."""
     @property
     def has_color(self) -> bool: ...
     @property
@@ -384,7 +389,37 @@ def explore(
     threads: int | None = None,
     max_memory: int | None = None,
     progress: Callable[[dict[str, Any]], object] | None = None,
-) -> ExploreResult: ...
+    robot_config: PathLike | None = None,
+    fov_deg: float | None = None,
+    max_range: float | None = None,
+    clear_beyond_range: bool = True,
+    odometry_noise: tuple[float, float] | None = None,
+    planner_picture: bool = False,
+    planner_hard_limit: float = 10.0,
+    planner_hard_limit_min: float = 2.0,
+    capture_hz: float | None = None,
+    fuse_step: float = 0.25,
+    fuse_step_deg: float = 15.0,
+    progress_interval: float = 30.0,
+    up: str = "z",
+    scale: float = 1.0,
+    floor_z: float | str = 0.0,
+) -> ExploreResult:
+    """One exploration experiment, as `voxplan explore` runs it; every CLI option is a keyword.
+
+    robot_config: a robot JSON file over the profile's robot (explore/robot_config.h);
+    fov_deg (strictly between 1 and 179), max_range (metres, above 0.1 and at most 100),
+    capture_hz (0 to 60; 0: frames by displacement): the explorer camera, None keeping the
+    profile's, the file's or the built-in robot's (90 degrees, 5 m, 0);
+    clear_beyond_range: depth past max_range clears the free space before it;
+    odometry_noise: (per metre, per radian), each in [0, 1], for poses='tracked';
+    planner_picture: also write planner.png; planner_hard_limit (>= 1, times plan_budget) and
+    planner_hard_limit_min (seconds > 0): past the larger a plan call is given up
+    ('planner_hung'); fuse_step (m), fuse_step_deg, progress_interval (s), planning_interval,
+    plan_budget, eval_samples: in [1e-06, 1e+06]; scene files: up 'z' or 'y', scale to metres,
+    floor_z the floor height to move to 0 (within +-100 m, or 'auto'). Out of bounds: ValueError
+    naming the argument.
+    """
 
 def planners() -> list[str]:
     """Planner plugins explore finds by name."""

@@ -167,8 +167,9 @@ TEST(DistributedCli, TheTaskFarmRunsATaskFileOverTwoRanksAsInOrder) {
   const fs::path tasks = dir / "tasks.txt";
   {
     std::ofstream f(tasks);
+    // Long enough that the second rank is up and asking before the first has run them all.
     for (int i = 0; i < 6; ++i)
-      f << "sleep 0.2; echo task " << i << " > " << (dir / Numbered("out", i)).string() << "\n";
+      f << "sleep 0.5; echo task " << i << " > " << (dir / Numbered("out", i)).string() << "\n";
     f << "exit 4\n";
   }
   const RunResult r =

@@ -3,7 +3,8 @@
 // input is tried twice: as given, and with its last 8 bytes replaced by the checksum of the rest
 // (FNV-1a 64, as map_io.cpp computes it), which lets the fuzzer reach the block records and the
 // voxels behind them. An accepted map must mesh to indices in range, ray cast the same with the
-// scalar and the AVX2 march, and save and load back to the same blocks.
+// scalar and the AVX2 march, and save and load back to the same blocks and up axis (version 1
+// files load as unknown up and save as version 2).
 #include <algorithm>
 #include <cstdint>
 #include <cstdlib>
@@ -59,11 +60,12 @@ void CheckRaycast(const TsdfVolume& volume) {
     std::abort();
 }
 
-void CheckRoundTrip(const TsdfVolume& volume) {
+void CheckRoundTrip(const TsdfVolume& volume, WorldUp up) {
   const std::string path = (fuzz::ScratchDir() / "saved.vpmap").string();
-  if (!SaveMap(volume, path).ok()) std::abort();
-  const Result<TsdfVolume> again = LoadMap(path);
-  if (!again.ok() || again->num_blocks() != volume.num_blocks()) std::abort();
+  if (!SaveMap(volume, path, up).ok()) std::abort();
+  WorldUp up_again = WorldUp::kUnknown;
+  const Result<TsdfVolume> again = LoadMap(path, &up_again);
+  if (!again.ok() || again->num_blocks() != volume.num_blocks() || up_again != up) std::abort();
   volume.ForEachBlock([&](BlockIndex b, const TsdfBlock& block) {
     const TsdfBlock* other = again->FindBlock(b);
     if (!other || std::memcmp(other, &block, sizeof(TsdfBlock)) != 0) std::abort();
@@ -72,12 +74,14 @@ void CheckRoundTrip(const TsdfVolume& volume) {
 
 void Try(const std::string& path) {
   const Result<MapHeader> header = ReadMapHeader(path);
-  const Result<TsdfVolume> volume = LoadMap(path);
+  WorldUp up = WorldUp::kUnknown;
+  const Result<TsdfVolume> volume = LoadMap(path, &up);
   if (!volume.ok()) return;
-  if (!header.ok() || header->num_blocks != volume->num_blocks()) std::abort();
+  if (!header.ok() || header->num_blocks != volume->num_blocks() || header->up != up) std::abort();
+  if (header->version == 1 && up != WorldUp::kUnknown) std::abort();
   CheckMesh(*volume);
   CheckRaycast(*volume);
-  CheckRoundTrip(*volume);
+  CheckRoundTrip(*volume, up);
 }
 
 }  // namespace

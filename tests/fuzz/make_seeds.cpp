@@ -1,13 +1,18 @@
 // Writes the fuzz targets' seed corpora: `fuzz_make_seeds OUT_DIR [SHARED_DATA_DIR]` fills
 // OUT_DIR/<target>/ with small inputs: fixtures the library writes itself (a map, a mesh in each
-// format, PNGs of each kind, a trajectory), each dataset role's default file, planner configs,
+// format, PNGs of each kind, a trajectory, ScanNet .sens scans, ROS bags and each bag slot's
+// message), each dataset role's default file, planner configs,
 // and, when the shared data is there, excerpts of it (first lines of its text files, the first
 // bytes of its meshes and colour images, crops of its depth images). Nothing is committed.
+#include <zlib.h>
+
+#include <bit>
 #include <cmath>
 #include <cstdint>
 #include <cstdio>
 #include <fstream>
 #include <iostream>
+#include <limits>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -17,9 +22,11 @@
 #include "io/image_io.h"
 #include "io/map_io.h"
 #include "io/mesh_io.h"
+#include "io/sens_file.h"
 #include "io/tum_trajectory.h"
 #include "tests/fuzz/dataset_scaffold.h"
 #include "tests/fuzz/fuzz_support.h"
+#include "tests/fuzz/rosbag_scaffold.h"
 
 namespace {
 
@@ -70,6 +77,16 @@ void LibraryFixtures(const fs::path& out) {
   Put(out / "fuzz_map", "sphere.vpmap", ReadAll(tmp / "m.vpmap"));
   if (!SaveMap(TsdfVolume({0.01f, 0.04f}), (tmp / "e.vpmap").string()).ok()) std::abort();
   Put(out / "fuzz_map", "empty.vpmap", ReadAll(tmp / "e.vpmap"));
+  // Version 2 with an up axis, and the same map as version 1 wrote it (no up field).
+  if (!SaveMap(SphereVolume(), (tmp / "y.vpmap").string(), WorldUp::kPlusY).ok()) std::abort();
+  const std::string y_up = ReadAll(tmp / "y.vpmap");
+  Put(out / "fuzz_map", "sphere_y_up.vpmap", y_up);
+  std::string v1 = y_up.substr(0, 28) + y_up.substr(32, y_up.size() - 32 - 8);
+  v1[8] = 1;                           // the version's low byte (little-endian)
+  uint64_t h = 0xcbf29ce484222325ull;  // FNV-1a 64, as map_io.cpp checksums
+  for (unsigned char c : v1) h = (h ^ c) * 0x100000001b3ull;
+  v1.append(reinterpret_cast<const char*>(&h), 8);
+  Put(out / "fuzz_map", "sphere_v1.vpmap", v1);
 
   const char* const extensions[] = {".ply", ".obj", ".glb", ".stl"};  // fuzz_mesh's first byte
   for (int e = 0; e < 4; ++e) {
@@ -102,6 +119,151 @@ void LibraryFixtures(const fs::path& out) {
   Put(out / "fuzz_tum_trajectory", "comments.txt",
       "\xEF\xBB\xBF# t tx ty tz qx qy qz qw\r\n1.0 0 0 0 0 0 0 1 # first\r\n\r\n"
       "+2.5 1e-3 -2 3 0 0 0.7071068 0.7071068\r\n");
+}
+
+// --- ScanNet .sens (SensorData version 4, little-endian; tests/io/sens_fixture.h writes the same)
+void PutU32(std::string& out, uint32_t v) {
+  for (int i = 0; i < 4; ++i) out.push_back(char((v >> (8 * i)) & 0xff));
+}
+void PutU64(std::string& out, uint64_t v) {
+  for (int i = 0; i < 8; ++i) out.push_back(char((v >> (8 * i)) & 0xff));
+}
+void PutMatrix(std::string& out, const Eigen::Matrix4f& m) {
+  for (int r = 0; r < 4; ++r)
+    for (int c = 0; c < 4; ++c) PutU32(out, std::bit_cast<uint32_t>(m(r, c)));
+}
+Eigen::Matrix4f Intrinsic(float f, int width, int height) {
+  Eigen::Matrix4f k = Eigen::Matrix4f::Identity();
+  k(0, 0) = k(1, 1) = f;
+  k(0, 2) = float(width - 1) / 2.f;
+  k(1, 2) = float(height - 1) / 2.f;
+  return k;
+}
+
+struct SensSeedFrame {
+  Eigen::Matrix4f pose = Eigen::Matrix4f::Identity();
+  std::string color, depth;
+};
+
+std::string EncodeSens(const SensHeader& h, const std::vector<SensSeedFrame>& frames) {
+  std::string out;
+  PutU32(out, 4);
+  PutU64(out, h.sensor_name.size());
+  out += h.sensor_name;
+  for (const Eigen::Matrix4f* m :
+       {&h.color_intrinsic, &h.color_extrinsic, &h.depth_intrinsic, &h.depth_extrinsic})
+    PutMatrix(out, *m);
+  PutU32(out, uint32_t(h.color_compression));
+  PutU32(out, uint32_t(h.depth_compression));
+  for (int side : {h.color_width, h.color_height, h.depth_width, h.depth_height})
+    PutU32(out, uint32_t(side));
+  PutU32(out, std::bit_cast<uint32_t>(h.depth_shift));
+  PutU64(out, frames.size());
+  for (size_t i = 0; i < frames.size(); ++i) {
+    PutMatrix(out, frames[i].pose);
+    PutU64(out, 1000000 + 33333 * i);  // colour, depth timestamps (us)
+    PutU64(out, 1000000 + 33333 * i);
+    PutU64(out, frames[i].color.size());
+    PutU64(out, frames[i].depth.size());
+    out += frames[i].color;
+    out += frames[i].depth;
+  }
+  return out;
+}
+
+std::string RawDepth(int width, int height, int frame) {
+  std::string raw;
+  for (int k = 0; k < width * height; ++k) {
+    const unsigned mm = unsigned(1500 + 10 * k + 50 * frame);
+    raw.push_back(char(mm & 0xff));
+    raw.push_back(char(mm >> 8));
+  }
+  return raw;
+}
+
+std::string Zlib(const std::string& raw) {
+  uLongf size = compressBound(uLong(raw.size()));
+  std::string out(size, '\0');
+  if (compress2(reinterpret_cast<Bytef*>(out.data()), &size,
+                reinterpret_cast<const Bytef*>(raw.data()), uLong(raw.size()), 6) != Z_OK)
+    std::abort();
+  out.resize(size);
+  return out;
+}
+
+std::string RawRgb(const ColorImage& c) {
+  std::string out;
+  for (uint32_t p : c.data) {
+    out.push_back(char(Red(p)));
+    out.push_back(char(Green(p)));
+    out.push_back(char(Blue(p)));
+  }
+  return out;
+}
+
+void SensSeeds(const fs::path& out) {
+  const fs::path dir = out / "fuzz_sens";
+  // ScanNet's own kind: zlib depth 4x3, JPEG colour at twice the size (a resize), one lost pose.
+  SensHeader h;
+  h.sensor_name = "StructureSensor";
+  h.depth_width = 4, h.depth_height = 3, h.color_width = 8, h.color_height = 6;
+  h.depth_intrinsic = Intrinsic(4.f, 4, 3);
+  h.color_intrinsic = Intrinsic(8.f, 8, 6);
+  h.color_extrinsic = h.depth_extrinsic = Eigen::Matrix4f::Identity();
+  const std::string jpeg = EncodeJpeg(fuzz::BagColor(8, 6), 90).value();
+  std::vector<SensSeedFrame> frames(3);
+  for (int i = 0; i < 3; ++i) {
+    frames[size_t(i)].pose(0, 3) = 0.05f * float(i);
+    frames[size_t(i)].color = jpeg;
+    frames[size_t(i)].depth = Zlib(RawDepth(4, 3, i));
+  }
+  frames[1].pose.setConstant(-std::numeric_limits<float>::infinity());
+  Put(dir, "scannet.sens", EncodeSens(h, frames));
+
+  // Raw depth and raw colour of the same size, the colour camera 2 cm to the side.
+  h.sensor_name = "raw";
+  h.color_compression = SensColorCompression::kRaw;
+  h.depth_compression = SensDepthCompression::kRawUshort;
+  h.color_width = 4, h.color_height = 3;
+  h.color_intrinsic = Intrinsic(4.f, 4, 3);
+  h.depth_extrinsic(0, 3) = 0.02f;
+  std::vector<SensSeedFrame> raw(2);
+  for (int i = 0; i < 2; ++i) {
+    raw[size_t(i)].color = RawRgb(fuzz::BagColor(4, 3));
+    raw[size_t(i)].depth = RawDepth(4, 3, i);
+  }
+  Put(dir, "raw.sens", EncodeSens(h, raw));
+
+  // PNG colour; and depth alone (no colour size, no colour bytes).
+  const fs::path png = fuzz::ScratchDir() / "sens.png";
+  std::vector<uint8_t> rgb(4 * 3 * 3, 200);
+  if (!WritePngRaw(png.string(), 4, 3, 3, 8, rgb.data()).ok()) std::abort();
+  h.sensor_name = "png";
+  h.color_compression = SensColorCompression::kPng;
+  h.depth_compression = SensDepthCompression::kZlibUshort;
+  h.depth_extrinsic = Eigen::Matrix4f::Identity();
+  std::vector<SensSeedFrame> with_png(2);
+  for (int i = 0; i < 2; ++i) {
+    with_png[size_t(i)].color = ReadAll(png);
+    with_png[size_t(i)].depth = Zlib(RawDepth(4, 3, i));
+  }
+  Put(dir, "png.sens", EncodeSens(h, with_png));
+  h.sensor_name = "";
+  h.color_width = h.color_height = 0;
+  for (SensSeedFrame& f : with_png) f.color.clear();
+  Put(dir, "depth_only.sens", EncodeSens(h, with_png));
+}
+
+// --- ROS 1 bags: the scaffold's two layouts whole, and each slot's message
+void BagSeeds(const fs::path& out) {
+  const fs::path tmp = fuzz::ScratchDir() / "seed.bag";
+  for (auto [layout, name] : {std::pair{fuzz::BagLayout::kA, "tf_bgr8_16uc1.bag"},
+                              std::pair{fuzz::BagLayout::kB, "pose_jpeg_32fc1.bag"}}) {
+    fuzz::WriteBagFile(tmp.string(), fuzz::BagMessages(layout));
+    Put(out / "fuzz_rosbag", name, ReadAll(tmp));
+  }
+  for (size_t s = 0; s < fuzz::kNumBagSlots; ++s)
+    Put(out / "fuzz_ros_messages", "slot" + std::to_string(s), char(s) + fuzz::SlotDefault(s));
 }
 
 void HandWritten(const fs::path& out) {
@@ -196,6 +358,8 @@ int main(int argc, char** argv) {
   }
   const fs::path out = argv[1];
   LibraryFixtures(out);
+  SensSeeds(out);
+  BagSeeds(out);
   HandWritten(out);
   if (argc > 2) SharedData(out, argv[2]);
   return 0;

@@ -166,6 +166,13 @@ TEST(Sens, CorruptHeadersAndFramesAreRefused) {
   s.frames[1].color_bytes.clear();
   refused(s, {"frame 1", "no colour"});
 
+  // A zlib stream too short to inflate to the header's image (at most 1032-fold) is refused at
+  // open, before a buffer of the header's size is allocated (a file of a few KiB could make each
+  // Load allocate up to 128 MiB).
+  s = test::MakeWallScan();
+  s.header.depth_width = s.header.depth_height = 4096;
+  refused(s, {"frame 0", "cannot inflate to the header's 4096x4096"});
+
   // A frame count the file cannot hold is refused before anything is reserved.
   s = test::MakeWallScan();
   std::string bytes = test::EncodeSens(s.header, s.frames);

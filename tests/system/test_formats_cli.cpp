@@ -3,13 +3,19 @@
 // frame skipped and counted, and the file itself is refused as an output; so is a ROS 1 bag
 // written by rosbag, its topics found or named with --topics; a ROS 2 bag is refused saying how
 // to convert it. `fuse` also writes the surface as a point cloud and the occupancy as OctoMap.
+// Float depth: a TUM-style folder of 32-bit float TIFF or EXR depth (metres) fuses into the same
+// map, checksum for checksum, as the same depths in 16-bit PNGs at scale 1000.
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <filesystem>
+#include <limits>
 #include <string>
 #include <vector>
 
+#include "io/image_io.h"
 #include "tests/io/bag_fixture.h"
+#include "tests/io/float_depth_fixture.h"
 #include "tests/io/sens_fixture.h"
 #include "tests/support/test_support.h"
 #include "tests/system/cli_runner.h"
@@ -154,6 +160,99 @@ TEST(FormatsCli, Ros2BagRefusedWithHowToConvert) {
     EXPECT_NE(r.err.find("rosbags-convert"), std::string::npos) << Describe(r);
     EXPECT_NE(r.err.find(db3.string()), std::string::npos) << Describe(r);
   }
+}
+
+// A TUM-style folder of `frames` views of a tilted wall, every depth a whole number of
+// millimetres (so that 16-bit PNG at scale 1000 and float metres hold the same values), a few
+// pixels invalid: ext ".png" writes the millimetres, ".tif" / ".exr" float metres (invalid
+// pixels as NaN, -1 and 0, which read as 0 like the PNG's 0).
+fs::path WriteWallFolder(const fs::path& root, const std::string& ext, int frames) {
+  const int w = 48, h = 36;
+  std::string list, gt;
+  for (int k = 0; k < frames; ++k) {
+    std::vector<uint16_t> mm(size_t(w * h));
+    DepthImage metres(w, h);
+    for (int y = 0; y < h; ++y)
+      for (int x = 0; x < w; ++x) {
+        const size_t i = size_t(y * w + x);
+        mm[i] = uint16_t(1200 + 7 * x + 3 * y + 11 * k);
+        if ((x * 13 + y * 7 + k) % 29 == 0) mm[i] = 0;
+        // As ReadDepthPng converts units (io/image_io.cpp).
+        metres.data[i] = float(double(mm[i]) * (1.0 / 1000.0));
+        if (mm[i] == 0) {
+          const float invalid[3] = {std::numeric_limits<float>::quiet_NaN(), -1.f, 0.f};
+          metres.data[i] = invalid[(x + y) % 3];
+        }
+      }
+    const std::string name = "depth/" + std::to_string(k) + ext;
+    if (ext == ".png") {
+      fs::create_directories(root / "depth");
+      EXPECT_TRUE(WritePngRaw((root / name).string(), w, h, 1, 16, mm.data()).ok());
+    } else {
+      test::WriteFloatDepth(root / name, metres);
+    }
+    const std::string t = std::to_string(10.0 + 0.1 * k);
+    list += t + " " + name + "\n";
+    gt += t + " " + std::to_string(0.02 * k) + " 0 " + std::to_string(-0.01 * k) + " 0 0 0 1\n";
+  }
+  test::WriteBytes(root / "depth.txt", list);
+  test::WriteBytes(root / "groundtruth.txt", gt);
+  test::WriteBytes(root / "camera.txt", "40 40 23.5 17.5\n");
+  return root;
+}
+
+// `voxplan fuse` of `dataset` into a map, then its checksum as `voxplan info` gives it.
+std::string FusedChecksum(const fs::path& dataset, const fs::path& map,
+                          const std::vector<std::string>& extra, nlohmann::json* stats) {
+  std::vector<std::string> args = {
+      "fuse", dataset.string(), "--voxel-size", "0.01", "--max-depth", "3", "--threads",
+      "2",    "--map",          map.string()};
+  args.insert(args.end(), extra.begin(), extra.end());
+  const RunResult fused = RunCli(args);
+  EXPECT_EQ(fused.exit_code, 0) << Describe(fused);
+  if (stats) *stats = fused.last_json;
+  const RunResult info = RunCli({"info", map.string()});
+  EXPECT_EQ(info.exit_code, 0) << Describe(info);
+  return info.last_json.is_object() ? info.last_json.value("checksum", "") : "";
+}
+
+TEST(FormatsCli, FloatDepthFusesLikeSixteenBitPng) {
+  const test::TempDir dir("voxplan-float-depth");
+  const fs::path png = WriteWallFolder(dir / "png", ".png", 3);
+  nlohmann::json png_stats;
+  const std::string reference =
+      FusedChecksum(png, dir / "png.vpmap", {"--depth-scale", "1000"}, &png_stats);
+  ASSERT_FALSE(reference.empty());
+  EXPECT_EQ(png_stats.at("depth_encoding"), "16-bit PNG");
+  EXPECT_TRUE(png_stats.at("depth_scale_applies").get<bool>());
+  EXPECT_GT(png_stats.at("blocks").get<int>(), 0);
+  for (const char* ext : {".tif", ".exr"}) {
+    SCOPED_TRACE(ext);
+    const fs::path folder = WriteWallFolder(dir / (std::string("float") + ext), ext, 3);
+    const RunResult info = RunCli({"info", folder.string()});
+    ASSERT_EQ(info.exit_code, 0) << Describe(info);
+    const std::string encoding =
+        std::string("32-bit float ") + (std::string(ext) == ".exr" ? "EXR" : "TIFF");
+    EXPECT_EQ(info.last_json.at("depth_encoding"), encoding);
+    EXPECT_FALSE(info.last_json.at("depth_scale_applies").get<bool>());
+    EXPECT_NE(info.err.find(encoding + ", metres (the depth scale does not apply)"),
+              std::string::npos)
+        << Describe(info);
+    nlohmann::json stats;
+    // No depth scale given (TUM's 5000 is in force, and ignored: the files are metres).
+    EXPECT_EQ(FusedChecksum(folder, dir / (std::string("float") + ext + ".vpmap"), {}, &stats),
+              reference);
+    EXPECT_EQ(stats.at("depth_encoding"), encoding);
+    EXPECT_FALSE(stats.at("depth_scale_applies").get<bool>());
+    EXPECT_EQ(stats.at("frames").get<int>(), 3);
+  }
+  // A user who switched OpenCV's EXR reader off is told so, naming the file.
+  const RunResult off =
+      RunCli({"fuse", (dir / "float.exr").string(), "--stats", (dir / "off.json").string()},
+             "OPENCV_IO_ENABLE_OPENEXR=0");
+  EXPECT_EQ(off.exit_code, 1) << Describe(off);
+  EXPECT_NE(off.err.find("OPENCV_IO_ENABLE_OPENEXR=0"), std::string::npos) << Describe(off);
+  EXPECT_NE(off.err.find("0.exr"), std::string::npos) << Describe(off);
 }
 
 }  // namespace

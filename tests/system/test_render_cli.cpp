@@ -1,7 +1,8 @@
 // System tests of `voxplan render` and `voxplan eval trajectory`: the built executable run as a
 // user would, checking exit codes, the JSON last line, the images written and, on failure, that
-// nothing was written; the up axis a map records (and a version 1 map's default), and upright
-// renders at a y-flipped dataset's poses.
+// nothing was written; the default orbit framed on a map's surface (not its stray blocks), the
+// up axis a map records (and a version 1 map's default), and upright renders at a y-flipped
+// dataset's poses.
 #include <gtest/gtest.h>
 #include <sys/wait.h>
 
@@ -119,6 +120,42 @@ void WriteYUpRoomMap(const fs::path& path, WorldUp up, bool version1 = false) {
   if (version1) RewriteAsVersion1(path);
 }
 
+// A z-up 4 x 3 x 2.5 m room fused from inside (the distance positive in the room), 5 cm voxels,
+// and the stray blocks a real map collects: three 20 cm patches of noise surface and a trail of
+// free-space blocks, up to 14 m out.
+void WriteRoomMapWithStrays(const fs::path& path) {
+  const float voxel = 0.05f, trunc = 0.2f, block_m = voxel * kBlockSide;
+  TsdfVolume volume(VolumeParams{voxel, trunc});
+  const Eigen::Vector3f lo = Eigen::Vector3f::Zero(), hi(4.f, 3.f, 2.5f);
+  const auto room = [&](const Eigen::Vector3f& p) {
+    return std::min((p - lo).minCoeff(), (hi - p).minCoeff());
+  };
+  const auto fill = [&](BlockIndex b, const auto& sdf) {
+    TsdfBlock& block = volume.FindOrAllocate(b);
+    for (int i = 0; i < kBlockVoxels; ++i) {
+      const Eigen::Vector3f c = VoxelCenter(GlobalOf(b, VoxelOfLinear(i)), voxel);
+      block.tsdf[i] = EncodeTsdf(std::clamp(sdf(c, VoxelOfLinear(i)) / trunc, -1.0f, 1.0f));
+      block.weight[i] = EncodeWeight(1.0f);
+      block.r[i] = 150, block.g[i] = 120, block.b[i] = 90;
+    }
+  };
+  for (int bx = -1; bx <= 10; ++bx)
+    for (int by = -1; by <= 7; ++by)
+      for (int bz = -1; bz <= 6; ++bz) {
+        const BlockIndex b{bx, by, bz};
+        const Eigen::Vector3f centre = BlockOrigin(b, block_m) + Eigen::Vector3f::Constant(0.2f);
+        if (std::abs(room(centre)) <= trunc + block_m)
+          fill(b, [&](const Eigen::Vector3f& c, VoxelIndex) { return room(c); });
+      }
+  for (const BlockIndex b : {BlockIndex{30, 4, 2}, BlockIndex{-20, 25, 3}, BlockIndex{5, -22, 15}})
+    fill(b, [&](const Eigen::Vector3f& c, VoxelIndex v) {
+      return v.x < 4 && v.y < 4 ? c.z() - BlockOrigin(b, block_m).z() - 0.2f : trunc;
+    });
+  for (int x = 11; x <= 35; ++x)
+    fill({x, 4, 3}, [&](const Eigen::Vector3f&, VoxelIndex) { return trunc; });
+  ASSERT_TRUE(SaveMap(volume, path.string(), WorldUp::kPlusZ).ok());
+}
+
 bool EmptyOrMissing(const fs::path& dir) {
   std::error_code ec;
   return !fs::exists(dir, ec) || fs::is_empty(dir, ec);
@@ -139,6 +176,7 @@ TEST(RenderCliTest, MeshTurntableWritesNamedPngs) {
   EXPECT_EQ(j.at("views").get<int>(), 3);
   ASSERT_EQ(j.at("files").size(), 3u);
   EXPECT_GT(j.at("hit_fraction").get<double>(), 0.05);
+  EXPECT_EQ(j.at("framed_on"), "bounds");
   for (int k = 0; k < 3; ++k) {
     const fs::path png = out / ("render_00" + std::to_string(k) + ".png");
     EXPECT_EQ(j.at("files")[size_t(k)].get<std::string>(), png.string());
@@ -241,6 +279,44 @@ TEST(RenderCliTest, RefusesBadArgumentsAndWritesNothing) {
   const RunResult below_file = RunCli({"render", mesh.string(), "--out", (file / "sub").string()});
   EXPECT_EQ(below_file.exit_code, 2) << Describe(below_file);
   EXPECT_EQ(ReadAll(file), "x");
+}
+
+// The default orbit frames a map's surface, not the union of its blocks: a room with stray
+// blocks 14 m out fills its views, as the blocks' box could not (0.01 of the pixels); given
+// numbers still win, and a mesh is framed on its bounds.
+TEST(RenderCliTest, AMapsDefaultOrbitFramesItsRoomNotItsStrayBlocks) {
+  const test::TempDir dir("voxplan-render-framing");
+  const fs::path map = dir / "room.vpmap";
+  WriteRoomMapWithStrays(map);
+  const RunResult r = RunCli({"render", map.string(), "--orbit", "8", "--size", "80x60",
+                              "--threads", "2", "--out", (dir / "orbit").string()});
+  ASSERT_EQ(r.exit_code, 0) << Describe(r);
+  const json& j = r.last_json;
+  EXPECT_EQ(j.at("framed_on"), "surface") << Describe(r);
+  EXPECT_GT(j.at("bounds_max").at(0).get<double>(), 14.0);  // the blocks' box
+  EXPECT_GT(j.at("hit_fraction").get<double>(), 0.3) << Describe(r);
+  const double room_centre[3] = {2.0, 1.5, 1.25};
+  for (size_t k = 0; k < 3; ++k)
+    EXPECT_NEAR(j.at("centre").at(k).get<double>(), room_centre[k], 0.1) << Describe(r);
+  // The same bytes again.
+  const RunResult again = RunCli({"render", map.string(), "--orbit", "8", "--size", "80x60",
+                                  "--threads", "1", "--out", (dir / "again").string()});
+  ASSERT_EQ(again.exit_code, 0) << Describe(again);
+  for (int k = 0; k < 8; ++k) {
+    const std::string name = "render_00" + std::to_string(k) + ".png";
+    EXPECT_EQ(ReadAll(dir / "orbit" / name), ReadAll(dir / "again" / name)) << name;
+  }
+  const RunResult given =
+      RunCli({"render", map.string(), "--orbit", "2", "--size", "80x60", "--orbit-radius", "9",
+              "--orbit-height", "-4", "--out", (dir / "given").string()});
+  ASSERT_EQ(given.exit_code, 0) << Describe(given);
+  EXPECT_EQ(given.last_json.at("orbit_radius_m").get<double>(), 9.0);
+  EXPECT_EQ(given.last_json.at("orbit_height_m").get<double>(), -4.0);
+  const RunResult posed = RunCli({"render", map.string(), "--pose", "2 1.5 8 1 0 0 0", "--size",
+                                  "80x60", "--out", (dir / "posed").string()});
+  ASSERT_EQ(posed.exit_code, 0) << Describe(posed);
+  EXPECT_FALSE(posed.last_json.contains("framed_on"));
+  EXPECT_GT(posed.last_json.at("hit_fraction").get<double>(), 0.3) << Describe(posed);
 }
 
 // Normals mode: the floor (normal +y, green 255) and the wall (normal +z, blue 255) pixels of a

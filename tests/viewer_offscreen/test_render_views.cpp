@@ -1,11 +1,12 @@
 // The render job below the CLI: views of an analytic sphere map (orbit and single pose, image
-// sizes, hit fractions), upright pictures for a y-flipped camera, and the all-or-nothing
-// writing of their files.
+// sizes, hit fractions), orbits framed on a room map's surface whatever stray blocks it holds,
+// upright pictures for a y-flipped camera, and the all-or-nothing writing of their files.
 #include <gtest/gtest.h>
 
 #include <filesystem>
 #include <fstream>
 
+#include "core/parallel.h"
 #include "tests/support/test_support.h"
 #include "viewer_offscreen/map_scene.h"
 #include "viewer_offscreen/render_views.h"
@@ -132,6 +133,145 @@ TEST(RenderViewsTest, ChoosingTheSideOrbitsBelowASurfaceSeenOnlyFromBelow) {
   Result<RenderedViews> round = RenderViews(sphere, params);
   ASSERT_TRUE(round.ok());
   EXPECT_FALSE(round->from_below);
+}
+
+// --- Framing an orbit on a map's surface -------------------------------------------------------
+
+// A 4 x 3 x 2.5 m room fused from inside (the distance is positive in the room: its walls, floor
+// and ceiling face into it), 5 cm voxels; with `strays`, blocks far out that a real map collects
+// too: three patches of noise surface (20 cm squares, 0.3 % of the room's surface together) and a
+// trail of free-space blocks (observed, no surface), up to 14 m away.
+constexpr float kRoomVoxel = 0.05f;
+const test::Box kRoom{Eigen::Vector3f::Zero(), Eigen::Vector3f(4.f, 3.f, 2.5f)};
+// The share of pixels a framed orbit of the room shows it in (measured at 80 x 60: 0.40 with the
+// strays, 0.44 without; framed on the block union with the strays, as before, 0.01).
+constexpr double kRoomFillsViews = 0.3;
+
+TsdfVolume RoomMap(bool strays) {
+  const VolumeParams params{kRoomVoxel, 4 * kRoomVoxel};
+  TsdfVolume volume = test::FillExactSdf([](const Eigen::Vector3f& p) { return -kRoom.Sdf(p); },
+                                         params, kRoom.lo - Eigen::Vector3f::Constant(0.3f),
+                                         kRoom.hi + Eigen::Vector3f::Constant(0.3f));
+  if (!strays) return volume;
+  const float block_m = volume.block_size_m();
+  const auto fill = [&](BlockIndex b, bool surface) {
+    TsdfBlock& block = volume.FindOrAllocate(b);
+    const float mid_z = BlockOrigin(b, block_m).z() + 0.5f * block_m;
+    for (int i = 0; i < kBlockVoxels; ++i) {
+      const Eigen::Vector3f c = VoxelCenter(GlobalOf(b, VoxelOfLinear(i)), kRoomVoxel);
+      const VoxelIndex v = VoxelOfLinear(i);
+      const bool patch = surface && v.x < 4 && v.y < 4;  // a 20 cm square of noise
+      block.tsdf[i] = EncodeTsdf(patch ? (c.z() - mid_z) / params.trunc_m : 1.0f);
+      block.weight[i] = EncodeWeight(1.0f);
+    }
+  };
+  for (const BlockIndex b : {BlockIndex{30, 4, 2}, BlockIndex{-20, 25, 3}, BlockIndex{5, -22, 15}})
+    fill(b, true);
+  for (int x = 11; x <= 35; ++x) fill({x, 4, 3}, false);
+  return volume;
+}
+
+// A scene that gives no surface samples, as a mesh: framed on its bounds.
+class BoxFramedScene : public SurfaceScene {
+ public:
+  explicit BoxFramedScene(const SurfaceScene& scene) : scene_(scene) {}
+  Eigen::AlignedBox3f Bounds() const override { return scene_.Bounds(); }
+  SurfaceImages Render(const PinholeCamera& camera, const Pose3f& T_W_C) const override {
+    return scene_.Render(camera, T_W_C);
+  }
+
+ private:
+  const SurfaceScene& scene_;
+};
+
+TEST(RenderViewsTest, AMapsOrbitFramesItsSurfaceNotItsStrayBlocks) {
+  const MapScene clean(RoomMap(false), MapSceneParams{});
+  const MapScene stray(RoomMap(true), MapSceneParams{});
+  EXPECT_GT(stray.Bounds().max().x(), 14.f);  // the blocks reach out
+  const std::vector<Eigen::Vector3f> samples = stray.SurfaceSamples();
+  ASSERT_FALSE(samples.empty());
+  size_t far_out = 0;
+  for (const Eigen::Vector3f& p : samples) far_out += std::abs(kRoom.Sdf(p)) > 2 * kRoomVoxel;
+  EXPECT_GT(far_out, 0u);
+  EXPECT_LT(double(far_out), 0.01 * double(samples.size()));
+
+  RenderViewsParams params = SmallViews();
+  params.width = 80;
+  params.height = 60;
+  params.orbit_views = 8;
+  params.choose_side = true;  // as `voxplan render` orbits
+  Result<RenderedViews> framed = RenderViews(stray, params);
+  Result<RenderedViews> reference = RenderViews(clean, params);
+  ASSERT_TRUE(framed.ok() && reference.ok());
+  EXPECT_TRUE(framed->surface_framed);
+  EXPECT_GT(framed->hit_fraction, kRoomFillsViews);
+  EXPECT_GT(reference->hit_fraction, kRoomFillsViews);
+  // The strays move the framing little (they take part of the 1 % the framing may leave out,
+  // so a little more of the room stays in: 4 % farther).
+  EXPECT_LT((framed->framing.centre_W - 0.5f * (kRoom.lo + kRoom.hi)).norm(), 0.1f);
+  EXPECT_LT((framed->framing.centre_W - reference->framing.centre_W).norm(), 0.05f);
+  EXPECT_NEAR(framed->framing.distance_m, reference->framing.distance_m,
+              0.08f * reference->framing.distance_m);
+  // Every view holds the room: its outermost bits touch the image border at a few pixels at most
+  // (5 of the 276 measured).
+  for (const Pose3f& T_W_C : framed->T_W_C) {
+    const SurfaceImages s = stray.Render(framed->camera, T_W_C);
+    int border = 0, border_hits = 0;
+    for (int v = 0; v < s.depth.height; ++v)
+      for (int u = 0; u < s.depth.width; ++u)
+        if (u == 0 || v == 0 || u == s.depth.width - 1 || v == s.depth.height - 1)
+          ++border, border_hits += s.depth.at(u, v) > 0.f;
+    EXPECT_LE(border_hits, border / 20);
+  }
+
+  // Given numbers win: the orbit the block union framed (FrameBox), which shows the room small.
+  const OrbitFraming boxed = FrameBox(stray.Bounds(), CameraFromFov(80, 60, params.fov_deg));
+  params.orbit_radius_m = boxed.radius_m;
+  params.orbit_height_m = boxed.height_m;
+  Result<RenderedViews> given = RenderViews(stray, params);
+  ASSERT_TRUE(given.ok());
+  EXPECT_EQ(given->framing.radius_m, boxed.radius_m);
+  EXPECT_EQ(given->framing.height_m, boxed.height_m);
+  EXPECT_LT(given->hit_fraction, 0.1 * framed->hit_fraction);
+
+  // A scene without samples (a mesh) frames its box as it always did.
+  params.orbit_radius_m.reset();
+  params.orbit_height_m.reset();
+  const BoxFramedScene box_framed(stray);
+  Result<RenderedViews> mesh_like = RenderViews(box_framed, params);
+  ASSERT_TRUE(mesh_like.ok());
+  EXPECT_FALSE(mesh_like->surface_framed);
+  EXPECT_EQ(mesh_like->framing.radius_m, boxed.radius_m);
+  EXPECT_EQ(std::abs(mesh_like->framing.height_m), boxed.height_m);
+  EXPECT_EQ(mesh_like->framing.centre_W, boxed.centre_W);
+  // A pose renders as given, with nothing framed.
+  params = SmallViews();
+  params.T_W_C = LookAt(Eigen::Vector3f(2.f, -3.f, 4.f), Eigen::Vector3f(2.f, 1.5f, 0.f));
+  Result<RenderedViews> posed = RenderViews(stray, params);
+  ASSERT_TRUE(posed.ok());
+  EXPECT_FALSE(posed->surface_framed);
+  EXPECT_TRUE(posed->T_W_C[0].isApprox(*params.T_W_C));
+}
+
+TEST(RenderViewsTest, SurfaceCrossingsAreTheObservedZeroCrossingsThinnedEvenly) {
+  const TsdfVolume room = RoomMap(false);
+  const std::vector<Eigen::Vector3f> all = SurfaceCrossings(room, 0.5f, 0);
+  ASSERT_FALSE(all.empty());
+  // Each lies within a voxel of a wall, floor or ceiling.
+  for (const Eigen::Vector3f& p : all)
+    ASSERT_LT(std::abs(kRoom.Sdf(p)), kRoomVoxel) << p.transpose();
+  // Thinned: at most the cap, every k-th, the same for any thread count.
+  const std::vector<Eigen::Vector3f> some = SurfaceCrossings(room, 0.5f, 1000);
+  EXPECT_LE(some.size(), 1000u);
+  EXPECT_GT(some.size(), 500u);
+  const size_t k = (all.size() + 999) / 1000;
+  for (size_t i = 0; i < some.size(); ++i) ASSERT_EQ(some[i], all[i * k]) << i;
+  {
+    const ThreadLimit one(1);
+    EXPECT_EQ(SurfaceCrossings(room, 0.5f, 1000), some);
+  }
+  // Voxels below the weight the rays see are not surface.
+  EXPECT_TRUE(SurfaceCrossings(room, 2.0f).empty());
 }
 
 // --- A y-flipped camera (fy < 0, ICL-NUIM's) ---------------------------------------------------
