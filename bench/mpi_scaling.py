@@ -2,19 +2,23 @@
 """Sharded fusion under mpirun: what each rank holds and does, and a model of a real cluster.
 
 For each voxel size and rank count, `mpirun -n N voxplan fuse DATASET --frames F --threads T`
-(N = 1 also without mpirun, the one-process reference) and its stats:
+(N = 1 also without mpirun, the one-process reference; N > 1 with --band-walk split and whole)
+and its stats:
 
   rank_peak_rss_mb   peak resident memory of every rank (the aim: about 1/N of one process's map)
   rank_blocks        blocks each rank owns (balance of the chunk hash)
   broadcast          bytes and time per frame rank 0 broadcasts (decoded depth + colour)
-  collect_ms         per frame, walking the truncation band to find one's blocks: every rank
-                     repeats it whole (the repeated share)
+  collect_ms         per frame, walking the truncation band to find one's blocks: with
+                     --band-walk whole every rank repeats it all (the repeated share); split (the
+                     default), each walks 1/N and the ranks exchange what they found
+  exchange_ms        per frame, that exchange (an all-to-all of block indices)
   update_ms          per frame, updating one's own blocks: split over the ranks (the split share)
 
 On a machine with fewer cores than N x T the wall times say nothing about scaling (the ranks
 share the cores); the model says what a cluster would see from the measured shares:
 
-  t(N) = decode / prefetch overlap + broadcast(N) + collect + update(1) * imbalance(N) / N
+  t(N) = decode / prefetch overlap + broadcast(N) + walk(N) + update(1) * imbalance(N) / N
+  walk(N) = collect(1) (whole) or collect(1) / N + exchange (split)
 
 with broadcast(N) = bytes / bandwidth * ceil(log2 N) (a binomial tree over --bandwidth-gbps) and
 imbalance(N) = max / mean of the blocks each of N ranks would own of the whole map (the owner
@@ -70,10 +74,11 @@ def imbalance(blocks: list, ranks: int) -> float:
 
 
 def run_fuse(voxplan: str, dataset: str, frames: int, voxel: float, ranks: int, threads: int,
-             mpirun: bool, out: str) -> dict:
-    stats = os.path.join(out, f"v{voxel}_n{ranks}_{'mpi' if mpirun else 'one'}.json")
+             mpirun: bool, out: str, walk: str = "split") -> dict:
+    stats = os.path.join(out, f"v{voxel}_n{ranks}_{walk}_{'mpi' if mpirun else 'one'}.json")
     cmd = [voxplan, "fuse", dataset, "--frames", str(frames), "--voxel-size", str(voxel),
-           "--trunc", str(4 * voxel), "--threads", str(threads), "--stats", stats]
+           "--trunc", str(4 * voxel), "--threads", str(threads), "--stats", stats,
+           "--band-walk", walk]
     if not mpirun:
         cmd += ["--map", os.path.join(out, f"v{voxel}.vpmap")]
     if mpirun:
@@ -87,9 +92,13 @@ def run_fuse(voxplan: str, dataset: str, frames: int, voxel: float, ranks: int, 
 
 
 def model(row1: dict, mb_per_frame: float, blocks: list, ranks: int,
-          bandwidth_gbps: float) -> dict:
-    """Per-frame time on a cluster of `ranks` nodes from the one-rank shares."""
-    collect = row1["collect_ms_median"]
+          bandwidth_gbps: float, split_walk: bool, exchange_ms: float) -> dict:
+    """Per-frame time on a cluster of `ranks` nodes from the one-rank shares. With the band
+    walk split, each rank walks 1/N of it and the exchange (measured at the largest rank count
+    here, on shared memory) is added; else every rank walks it all."""
+    collect = row1["collect_ms_median"] / (ranks if split_walk else 1)
+    if split_walk and ranks > 1:
+        collect += exchange_ms
     update1 = row1["update_ms_median"]
     decode = row1["load_ms_median"]
     imb = imbalance(blocks, ranks)
@@ -98,7 +107,7 @@ def model(row1: dict, mb_per_frame: float, blocks: list, ranks: int,
         if ranks > 1 else 0.0
     work = bcast + collect + update1 * imb / ranks
     t = max(decode, work)  # decoding runs ahead on rank 0
-    t1 = max(decode, collect + update1)
+    t1 = max(decode, row1["collect_ms_median"] + update1)
     return {"ranks": ranks, "imbalance": round(imb, 3), "broadcast_ms": round(bcast, 3),
             "frame_ms": round(t, 3), "speedup": round(t1 / t, 2),
             "bound": "decode" if decode >= work else "fusion"}
@@ -126,13 +135,16 @@ def main() -> int:
                            False, tmp)
             blocks = map_blocks(os.path.join(tmp, f"v{voxel}.vpmap"))
             rows = []
-            for n in rank_counts:
+            for n, walk in [(n, w) for n in rank_counts for w in (["split", "whole"] if n > 1
+                                                                   else ["split"])]:
                 s = run_fuse(args.voxplan, args.dataset, args.frames, voxel, n, args.threads,
-                             True, tmp)
+                             True, tmp, walk)
                 rows.append({k: s.get(k) for k in [
                     "ranks", "blocks", "map_mb", "rank_blocks", "rank_map_mb", "rank_peak_rss_mb",
                     "broadcast_mb_per_frame", "broadcast_ms_median", "collect_ms_median",
-                    "update_ms_median", "integrate_ms_median", "load_ms_median", "loop_s", "fps"]})
+                    "update_ms_median", "exchange_ms_median", "integrate_ms_median",
+                    "load_ms_median", "loop_s", "fps"]})
+                rows[-1]["band_walk"] = walk if n > 1 else "none"
                 # One rank runs the one-process code path: its figures are the process's own.
                 rows[-1]["ranks"] = n
                 if n == 1:
@@ -148,22 +160,27 @@ def main() -> int:
                                                         "loop_s", "fps"]},
                 "runs": rows,
                 "repeated_share": round(share, 3),
-                "model": [model(base, max(r["broadcast_mb_per_frame"] or 0.0 for r in rows),
-                                blocks, m, args.bandwidth_gbps)
-                          for m in [int(x) for x in args.model_ranks.split(",")]],
+                "model": {walk: [model(base, max(r["broadcast_mb_per_frame"] or 0.0 for r in rows),
+                                       blocks, m, args.bandwidth_gbps, walk == "split",
+                                       max((r.get("exchange_ms_median") or 0.0) for r in rows))
+                                 for m in [int(x) for x in args.model_ranks.split(",")]]
+                          for walk in ["whole", "split"]},
             }
             out["sizes"].append(entry)
             print(f"voxel {voxel} m: one process {one['peak_rss_mb']} MiB peak, "
                   f"{one['map_mb']} MiB map; repeated share {share:.2f}", file=sys.stderr)
             for r in rows:
-                print(f"  {r['ranks']} ranks: peak RSS per rank {r['rank_peak_rss_mb']} MiB, "
+                print(f"  {r['ranks']} ranks ({r['band_walk']} walk): peak RSS per rank {r['rank_peak_rss_mb']} MiB, "
                       f"map per rank {r['rank_map_mb']} MiB, broadcast "
                       f"{r['broadcast_mb_per_frame']} MiB / {r['broadcast_ms_median']} ms, collect "
-                      f"{r['collect_ms_median']} ms, update {r['update_ms_median']} ms",
+                      f"{r['collect_ms_median']} ms, exchange {r.get('exchange_ms_median')} ms, "
+                      f"update {r['update_ms_median']} ms",
                       file=sys.stderr)
-            for m in entry["model"]:
-                print(f"  model {m['ranks']:3d} ranks: {m['frame_ms']} ms/frame, x{m['speedup']} "
-                      f"({m['bound']}-bound, imbalance {m['imbalance']})", file=sys.stderr)
+            for walk, ms in entry["model"].items():
+                for m in ms:
+                    print(f"  model ({walk} walk) {m['ranks']:3d} ranks: {m['frame_ms']} ms/frame, "
+                          f"x{m['speedup']} ({m['bound']}-bound, imbalance {m['imbalance']})",
+                          file=sys.stderr)
     if args.json:
         with open(args.json, "w") as f:
             json.dump(out, f, indent=1)

@@ -144,6 +144,40 @@ bool GetPiece(wire::Reader& r, BlockIndex& b, internal::BlockMesh& piece) {
   return true;
 }
 
+// Every rank's share of the band walk to the blocks' owners: each sends the blocks it found to
+// their owners and merges what it receives (each list sorted, so the union is too, deduplicated).
+class CommBandExchange final : public BandExchange {
+ public:
+  explicit CommBandExchange(Communicator& comm) : comm_(comm) {}
+  Result<std::vector<BlockIndex>> Exchange(const std::vector<BlockIndex>& found) override {
+    const uint32_t ranks = uint32_t(comm_.size());
+    std::vector<std::vector<BlockIndex>> to(ranks);
+    for (const BlockIndex& b : found) to[BlockOwner(b, ranks)].push_back(b);
+    std::vector<Bytes> out(ranks);
+    for (uint32_t r = 0; r < ranks; ++r) {
+      wire::Writer w;
+      w.PutVector(to[r]);
+      out[r] = w.Take();
+    }
+    Result<std::vector<Bytes>> in = comm_.AllToAll(out);
+    if (!in.ok()) return in.status();
+    std::vector<BlockIndex> owned;
+    for (const Bytes& bytes : *in) {
+      wire::Reader r(bytes);
+      std::vector<BlockIndex> part;
+      r.GetVector(part);
+      VOXPLAN_RETURN_IF_ERROR(r.Finish("band blocks from another rank"));
+      owned.insert(owned.end(), part.begin(), part.end());
+    }
+    std::sort(owned.begin(), owned.end());
+    owned.erase(std::unique(owned.begin(), owned.end()), owned.end());
+    return owned;
+  }
+
+ private:
+  Communicator& comm_;
+};
+
 // ---- Checkpoints ------------------------------------------------------------------------------
 
 // `resumed` then `more`, as one run's report.
@@ -170,6 +204,7 @@ FuseReport Concatenate(const FuseReport& resumed, const FuseReport& more) {
   append(r.frame_ms, more.frame_ms);
   append(r.track_ms, more.track_ms);
   append(r.collect_ms, more.collect_ms);
+  append(r.exchange_ms, more.exchange_ms);
   append(r.update_ms, more.update_ms);
   r.loop_s += more.loop_s;
   return r;
@@ -210,6 +245,7 @@ nlohmann::json FuseReportToJson(const FuseReport& report) {
           {"frame_ms", report.frame_ms},
           {"track_ms", report.track_ms},
           {"collect_ms", report.collect_ms},
+          {"exchange_ms", report.exchange_ms},
           {"update_ms", report.update_ms},
           {"loop_s", report.loop_s}};
 }
@@ -243,6 +279,7 @@ Result<FuseReport> FuseReportFromJson(const nlohmann::json& j) {
     r.frame_ms = j.at("frame_ms").get<std::vector<double>>();
     r.track_ms = j.at("track_ms").get<std::vector<double>>();
     r.collect_ms = j.at("collect_ms").get<std::vector<double>>();
+    r.exchange_ms = j.at("exchange_ms").get<std::vector<double>>();
     r.update_ms = j.at("update_ms").get<std::vector<double>>();
     r.loop_s = j.at("loop_s").get<double>();
     return r;
@@ -370,6 +407,8 @@ Result<ShardedFuseReport> FuseDatasetSharded(Communicator& comm, const Dataset* 
   }
   FuseParams fuse = params.fuse;
   fuse.integrate.shard = {uint32_t(comm.rank()), uint32_t(comm.size())};
+  CommBandExchange exchange(comm);
+  if (params.split_band_walk && comm.size() > 1) fuse.integrate.band_exchange = &exchange;
   const std::vector<size_t> rest(indices.begin() + std::ptrdiff_t(start), indices.end());
   FuseObserver shifted = observer;
   if (observer.progress)

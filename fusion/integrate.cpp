@@ -6,6 +6,7 @@
 #include <limits>
 #include <mutex>
 #include <string>
+#include <utility>
 
 #include "core/bounds.h"
 #include "core/parallel.h"
@@ -210,10 +211,17 @@ class EndPairCache {
 };
 
 // The band of every valid pixel, or with `carve` everything from min depth through the band.
+// [begin, end) of `units` work units: part `part.rank` of `part.ranks` equal shares in order.
+std::pair<size_t, size_t> ShareOf(size_t units, const ShardSpec& part) {
+  return {units * part.rank / part.ranks, units * (part.rank + 1) / part.ranks};
+}
+
+// With `part`, only that share of the image's work units (row tasks; with carving, corner rows)
+// is walked: the union of every part's blocks is the whole set.
 std::vector<BlockIndex> CollectBlocks(ImageView<float> depth, const PinholeCamera& camera,
                                       const Pose3f& T_W_C, const IntegrateParams& params,
                                       const VolumeParams& volume_params, bool carve,
-                                      size_t* valid_pixels = nullptr) {
+                                      size_t* valid_pixels = nullptr, const ShardSpec& part = {}) {
   const float trunc = volume_params.trunc_m;
   const float inv_block = 1.0f / (volume_params.voxel_size_m * kBlockSide);
   // Work in block units: a pixel's ray is dir(u, v) * z + origin, with dir linear in u and v.
@@ -261,10 +269,13 @@ std::vector<BlockIndex> CollectBlocks(ImageView<float> depth, const PinholeCamer
       }
     });
     const float start = std::max(params.min_depth_m, 1e-3f);
-    ParallelFor(size_t(tiles_v) + 1, 1, [&](size_t begin, size_t end) {
+    // Plain variables, not a structured binding: clang 14 cannot capture those in a lambda.
+    const std::pair<size_t, size_t> corner_rows = ShareOf(size_t(tiles_v) + 1, part);
+    const size_t first_corner_row = corner_rows.first, end_corner_row = corner_rows.second;
+    ParallelFor(end_corner_row - first_corner_row, 1, [&](size_t begin, size_t end) {
       KeyCollector collector;
       auto add = [&](BlockIndex b) { collector.Add(b); };
-      for (size_t cv = begin; cv < end; ++cv) {
+      for (size_t cv = first_corner_row + begin; cv < first_corner_row + end; ++cv) {
         // Corner row cv lies between tile rows cv - 1 and cv, at pixel edge v = cv * tile - 0.5.
         const float v = std::min(float(int(cv) * tile), float(depth.height)) - 0.5f;
         for (int cu = 0; cu <= tiles_u; ++cu) {
@@ -292,7 +303,10 @@ std::vector<BlockIndex> CollectBlocks(ImageView<float> depth, const PinholeCamer
                               : internal::BandRowCandidatesScalar;
   constexpr size_t kRowsPerTask = 16;
   const size_t tasks = (size_t(depth.height) + kRowsPerTask - 1) / kRowsPerTask;
-  ParallelFor(tasks, 1, [&](size_t begin, size_t end) {
+  const std::pair<size_t, size_t> share = ShareOf(tasks, part);
+  const size_t first_task = share.first, end_task = share.second;
+  ParallelFor(end_task - first_task, 1, [&](size_t share_begin, size_t share_end) {
+    const size_t begin = first_task + share_begin, end = first_task + share_end;
     KeyCollector collector;
     auto add = [&](BlockIndex b) { collector.Add(b); };
     EndPairCache walked;
@@ -399,14 +413,27 @@ Result<IntegrateStats> IntegrateFrame(ImageView<float> depth, ImageView<uint32_t
   IntegrateStats stats;
   Stopwatch clock;
   size_t valid_pixels = 0;
-  std::vector<BlockIndex> band =
-      CollectBlocks(depth, camera, T_W_C, params, volume.params(), params.carve_free_space,
-                    params.carve_free_space ? nullptr : &valid_pixels);
-  if (!params.shard.whole())
-    band.erase(std::remove_if(band.begin(), band.end(),
-                              [&](BlockIndex b) { return !params.shard.Owns(b); }),
-               band.end());
-  stats.collect_ms = clock.ElapsedMs();
+  std::vector<BlockIndex> band;
+  size_t* const count_valid = params.carve_free_space ? nullptr : &valid_pixels;
+  if (params.band_exchange && !params.shard.whole()) {
+    // This rank's share of the walk, then every rank's finds that it owns.
+    const std::vector<BlockIndex> walked =
+        CollectBlocks(depth, camera, T_W_C, params, volume.params(), params.carve_free_space,
+                      count_valid, params.shard);
+    stats.collect_ms = clock.ElapsedMs();
+    Result<std::vector<BlockIndex>> owned = params.band_exchange->Exchange(walked);
+    if (!owned.ok()) return owned.status();
+    band = std::move(*owned);
+    stats.exchange_ms = clock.ElapsedMs() - stats.collect_ms;
+  } else {
+    band = CollectBlocks(depth, camera, T_W_C, params, volume.params(), params.carve_free_space,
+                         count_valid);
+    if (!params.shard.whole())
+      band.erase(std::remove_if(band.begin(), band.end(),
+                                [&](BlockIndex b) { return !params.shard.Owns(b); }),
+                 band.end());
+    stats.collect_ms = clock.ElapsedMs();
+  }
   // Look the blocks up in parallel (concurrent finds are safe); only the missing ones are
   // allocated, serially, in band order.
   std::vector<TsdfBlock*> blocks(band.size());

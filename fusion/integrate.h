@@ -19,6 +19,15 @@ enum class Weighting {
 };
 enum class Kernel { kAuto, kScalar, kSimd };
 
+// How the ranks of a split map pool the blocks each found in its share of a frame's band
+// (distributed/sharded_fuse.cpp). Collective: every rank calls it once per IntegrateFrame, in
+// the same order; it returns the sorted, duplicate-free blocks of all ranks' finds this rank owns.
+class BandExchange {
+ public:
+  virtual ~BandExchange() = default;
+  virtual Result<std::vector<BlockIndex>> Exchange(const std::vector<BlockIndex>& found) = 0;
+};
+
 struct IntegrateParams {
   float min_depth_m = 0.1f;
   float max_depth_m = 3.0f;
@@ -39,8 +48,11 @@ struct IntegrateParams {
   // model, so they update only voxels still unobserved or free, never a fused surface.
   bool clear_beyond_max_depth = false;
   // A map split over ranks (distributed/): only the blocks this rank owns are allocated and
-  // updated; every rank still walks the frame's whole band to find them.
+  // updated. Without `band_exchange` every rank walks the frame's whole band to find them; with
+  // it, each walks its share of the image's rows and the exchange hands it every rank's finds
+  // that it owns (the same blocks, found once).
   ShardSpec shard;
+  BandExchange* band_exchange = nullptr;
 
   // Depth range within [0, bounds::kDepthMaxM] with min < max, max weight in (0, kMaxWeight],
   // a positive carve ray spacing; InvalidArgument naming the value and the range otherwise.
@@ -53,7 +65,10 @@ struct IntegrateStats {
   // New blocks the volume's memory budget refused: their voxels were not updated this frame.
   size_t blocks_refused = 0;
   size_t valid_pixels = 0;
-  double collect_ms = 0.0;   // finding the band's blocks: repeated by every rank of a split map
+  // Finding the band's blocks: the whole band on every rank of a split map, or with a band
+  // exchange each rank's share, then the exchange's time.
+  double collect_ms = 0.0;
+  double exchange_ms = 0.0;
   double allocate_ms = 0.0;  // collecting, looking up and allocating them
   double update_ms = 0.0;
   // Every block this frame updated, sorted (BlockIndex order) without duplicates, so maps

@@ -169,6 +169,7 @@ Result<FuseReport> FuseDataset(const Dataset& dataset, const std::vector<size_t>
       report.load_ms.push_back(load_ms);
       report.integrate_ms.push_back(integrate_ms);
       report.collect_ms.push_back(stats->collect_ms);
+      report.exchange_ms.push_back(stats->exchange_ms);
       report.update_ms.push_back(stats->update_ms);
       report.frame_ms.push_back(load_ms + integrate_ms);
       report.frames.push_back(

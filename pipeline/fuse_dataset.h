@@ -77,9 +77,10 @@ struct FuseReport {
   size_t blocks_refused = 0, frames_over_budget = 0;
   // Per integrated frame: decoding, integration, their sum; per tracked frame: tracking.
   std::vector<double> load_ms, integrate_ms, frame_ms, track_ms;
-  // Per integrated frame, within integrate_ms: finding the band's blocks (a split map repeats it
-  // on every rank) and updating them (split between ranks).
-  std::vector<double> collect_ms, update_ms;
+  // Per integrated frame, within integrate_ms: finding the band's blocks (a split map's ranks
+  // walk all of it, or each its share and then exchange what they found) and updating them
+  // (split between ranks).
+  std::vector<double> collect_ms, exchange_ms, update_ms;
   double loop_s = 0.0;  // the whole loop, skipped frames included
 };
 

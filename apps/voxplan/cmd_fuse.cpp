@@ -329,6 +329,13 @@ Command AddFuseCommand(CLI::App& app) {
   sub->add_flag("--resume", o->resume,
                 "Continue the run whose checkpoint is --map (same dataset, frames and "
                 "parameters; any rank count)");
+  sub->add_option("--band-walk", o->band_walk,
+                  "Under mpirun: every rank walks each frame's whole band to find its blocks, or "
+                  "each walks a share and the ranks send what they found to the owners (same map; "
+                  "split pays only where the exchange is cheaper than the walk, see "
+                  "distributed/README.md)")
+      ->check(CLI::IsMember({"split", "whole"}))
+      ->capture_default_str();
   sub->add_option("--prefetch", o->prefetch,
                   "Frames decoded ahead while one is fused (0: one after the other; same results)")
       ->check(CLI::Range(size_t(0), FuseParams::kMaxPrefetch))

@@ -30,8 +30,9 @@ struct FuseOptions {
   MemoryBudgetOptions memory;
   double max_pose_gap_s = 0.1;
   size_t prefetch = FuseParams::kDefaultPrefetch;
-  size_t checkpoint_every = 0;  // selected frames between checkpoints of --map (0: none)
-  bool resume = false;          // continue the run whose checkpoint --map is
+  size_t checkpoint_every = 0;      // selected frames between checkpoints of --map (0: none)
+  bool resume = false;              // continue the run whose checkpoint --map is
+  std::string band_walk = "whole";  // under mpirun: every rank walks the band, or "split" it
 };
 
 // The stats object: the same on the last stdout line and in --stats.

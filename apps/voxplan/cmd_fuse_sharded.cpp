@@ -105,6 +105,7 @@ int RunFuseSharded(const FuseOptions& o, Communicator& comm) {
   params.checkpoint_path = o.map_path;
   params.checkpoint_every = o.checkpoint_every;
   params.resume = o.resume;
+  params.split_band_walk = o.band_walk == "split";
   params.fingerprint = Fingerprint(o, info, indices);
   TsdfVolume local(VolumeParamsOf(o));
   if (comm.is_root()) {
@@ -242,6 +243,8 @@ int RunFuseSharded(const FuseOptions& o, Communicator& comm) {
             ? 0.0
             : RoundTo(Mib(fused->broadcast_bytes) / double(fused->broadcast_ms.size()), 3);
     j["broadcast_ms_median"] = RoundTo(bcast.median, 3);
+    j["band_walk"] = split ? o.band_walk : "whole";
+    j["exchange_ms_median"] = RoundTo(Summarize(report.exchange_ms).median, 3);
     j["write_s"] = RoundTo(write_clock.ElapsedS(), 3);
     if (!o.stats_path.empty()) {
       if (Status s = WriteJsonFile(j, o.stats_path); !s.ok())

@@ -1,6 +1,7 @@
 // The pieces of sharded fusion in one process: the owner function, integration and meshing of
-// a map split over ranks against the whole map, sharded maps and their checks, checkpoints and
-// resume with the serial communicator, the wire format's bounds and the task farm.
+// a map split over ranks against the whole map (the band walk split too), sharded maps and their
+// checks, checkpoints and resume with the serial communicator, the wire format's bounds and the
+// task farm.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -129,6 +130,82 @@ TEST(Shard, SplitIntegrationEqualsTheWholeVolumeBlockForBlock) {
       blocks += part.num_blocks();
     }
     EXPECT_EQ(blocks, whole.num_blocks()) << ranks << " ranks";
+  }
+}
+
+// A band exchange between ranks simulated in one process: the first pass records what each rank
+// found in its share of the walk; the second hands each rank its owned blocks of everyone's finds.
+class RecordingExchange final : public BandExchange {
+ public:
+  explicit RecordingExchange(uint32_t ranks) : found_(ranks), ranks_(ranks) {}
+  void Use(uint32_t rank, bool deliver) {
+    rank_ = rank;
+    deliver_ = deliver;
+  }
+  Result<std::vector<BlockIndex>> Exchange(const std::vector<BlockIndex>& found) override {
+    if (!deliver_) {
+      found_[rank_] = found;
+      return std::vector<BlockIndex>{};
+    }
+    std::vector<BlockIndex> owned;
+    for (const auto& part : found_)
+      for (const BlockIndex& b : part)
+        if (BlockOwner(b, ranks_) == rank_) owned.push_back(b);
+    std::sort(owned.begin(), owned.end());
+    owned.erase(std::unique(owned.begin(), owned.end()), owned.end());
+    return owned;
+  }
+  std::vector<std::vector<BlockIndex>> found_;
+
+ private:
+  uint32_t ranks_, rank_ = 0;
+  bool deliver_ = false;
+};
+
+TEST(Shard, ASplitBandWalkFindsTheWholeBandAndFusesTheSameBlocks) {
+  const RoomDataset d(1);
+  const Result<Frame> frame = d.Load(0);
+  ASSERT_TRUE(frame.ok());
+  const Pose3f T = Pose3f(frame->T_W_C->cast<float>());
+  for (const bool carve : {false, true}) {
+    IntegrateParams params;
+    params.carve_free_space = carve;
+    TsdfVolume whole(VolumeParams{kVoxel, kTrunc});
+    ASSERT_TRUE(IntegrateFrame(frame->depth, frame->color, d.info().camera, T, params, whole).ok());
+    const std::vector<BlockIndex> band =
+        BlocksToUpdate(frame->depth, d.info().camera, T, params, whole.params());
+    for (uint32_t ranks : {2u, 3u, 5u}) {
+      RecordingExchange exchange(ranks);
+      params.band_exchange = &exchange;
+      std::set<BlockIndex> found;
+      for (uint32_t rank = 0; rank < ranks; ++rank) {
+        params.shard = {rank, ranks};
+        exchange.Use(rank, /*deliver=*/false);
+        TsdfVolume scratch(VolumeParams{kVoxel, kTrunc});
+        ASSERT_TRUE(
+            IntegrateFrame(frame->depth, frame->color, d.info().camera, T, params, scratch).ok());
+        EXPECT_EQ(scratch.num_blocks(), 0u);
+        // Each rank walks a part: never all of it.
+        EXPECT_LT(exchange.found_[rank].size(), band.size()) << ranks << " ranks, carve " << carve;
+        found.insert(exchange.found_[rank].begin(), exchange.found_[rank].end());
+      }
+      EXPECT_EQ(std::vector<BlockIndex>(found.begin(), found.end()), band)
+          << ranks << " ranks, carve " << carve;
+      size_t blocks = 0;
+      for (uint32_t rank = 0; rank < ranks; ++rank) {
+        params.shard = {rank, ranks};
+        exchange.Use(rank, /*deliver=*/true);
+        TsdfVolume part(VolumeParams{kVoxel, kTrunc});
+        ASSERT_TRUE(
+            IntegrateFrame(frame->depth, frame->color, d.info().camera, T, params, part).ok());
+        part.ForEachBlock([&](BlockIndex b, const TsdfBlock& block) {
+          EXPECT_EQ(BlockOwner(b, ranks), rank);
+          EXPECT_TRUE(SameBlocks(*whole.FindBlock(b), block));
+        });
+        blocks += part.num_blocks();
+      }
+      EXPECT_EQ(blocks, whole.num_blocks());
+    }
   }
 }
 

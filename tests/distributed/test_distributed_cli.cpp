@@ -56,16 +56,20 @@ void ExpectSameOnAnyRankCount(const test::TempDir& dir, const std::vector<std::s
   ASSERT_EQ(base.exit_code, 0) << Describe(base);
   const std::string checksum = Checksum(map1), mesh = ReadAll(mesh1);
   ASSERT_GT(mesh.size(), 10000u);
-  for (int ranks : {1, 2, 4}) {
-    const std::string tag = Numbered("r", ranks);
+  // 2 ranks twice: with the whole band walked on every rank (the default) and split.
+  for (const auto& [ranks, walk] : std::vector<std::pair<int, std::string>>{
+           {1, "whole"}, {2, "whole"}, {2, "split"}, {4, "split"}}) {
+    const std::string tag = Numbered("r", ranks, walk);
     const fs::path map = dir / (tag + ".vpmap"), mesh_path = dir / (tag + ".ply");
     std::vector<std::string> split = args;
-    split.insert(split.end(), {"--map", map.string(), "--mesh", mesh_path.string()});
+    split.insert(split.end(),
+                 {"--map", map.string(), "--mesh", mesh_path.string(), "--band-walk", walk});
     const RunResult r = RunCli(split, Mpirun(ranks));
     ASSERT_EQ(r.exit_code, 0) << tag << "\n" << Describe(r);
     // One rank is the one-process run under mpirun; more report their ranks.
     if (ranks > 1) {
       EXPECT_EQ(r.last_json["ranks"], ranks) << Describe(r);
+      EXPECT_EQ(r.last_json["band_walk"], walk) << Describe(r);
     }
     EXPECT_EQ(r.last_json["blocks"], base.last_json["blocks"]) << tag;
     EXPECT_EQ(Checksum(map), checksum) << tag;
