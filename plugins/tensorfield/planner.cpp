@@ -458,6 +458,8 @@ StepOutput RobotPlanner::Step(const FloorInput& floor, const RobotInput& robot, 
                               const RouteServices& services) {
   StepOutput out;
   out.wakeup_t_s = sim_time_s + options_.substep_s;
+  prev_mode_ = emitted_mode_;
+  emitted_mode_ = StepMode::kNone;
   history_.push_back(robot.position_m);
   if (history_.size() > 32) history_.erase(history_.begin());
   if (options_.topology_control &&
@@ -515,6 +517,7 @@ StepOutput RobotPlanner::Step(const FloorInput& floor, const RobotInput& robot, 
     out.diag.retracted_wedges = retracted_wedges_;
     out.diag.moved_trisectors = moved_trisectors_;
     out.diag.settled_goals = static_cast<int>(visited_goals_.size());
+    out.diag.camera_stops = camera_stops_;
     return std::move(out);
   };
   // X7: no accessible edge with gain, and (ours) no frontier anyone could still reach.
@@ -561,7 +564,7 @@ StepOutput RobotPlanner::Step(const FloorInput& floor, const RobotInput& robot, 
     } else {
       std::vector<float> speeds(rest.size(), static_cast<float>(options_.speed_mps));
       out.diag.mode = r.kind;
-      EmitLine(rest, speeds, robot, gain, &out);
+      EmitLine(rest, speeds, robot, gain, false, &out);
       return finish();
     }
   }
@@ -588,13 +591,13 @@ StepOutput RobotPlanner::Step(const FloorInput& floor, const RobotInput& robot, 
       if (fallback()) {
         std::vector<float> speeds(route_->polyline.size(), static_cast<float>(options_.speed_mps));
         out.diag.mode = StepMode::kFrontier;
-        EmitLine(route_->polyline, speeds, robot, gain, &out);
+        EmitLine(route_->polyline, speeds, robot, gain, true, &out);
       }
       return finish();
     }
     std::vector<float> speeds(xy.size(), static_cast<float>(options_.speed_mps));
     out.diag.mode = StepMode::kAdvect;
-    EmitLine(xy, speeds, robot, gain, &out);
+    EmitLine(xy, speeds, robot, gain, false, &out);
     return finish();
   }
 
@@ -604,7 +607,8 @@ StepOutput RobotPlanner::Step(const FloorInput& floor, const RobotInput& robot, 
   blocked_.Add(line);
   out.diag.stop = static_cast<int>(line.stop);
   bool need_fallback = false;
-  if (line.Length() < min_move) {
+  const bool readvected = line.Length() < min_move;  // X5: a stop, the path split there
+  if (readvected) {
     const bool at_point =
         line.stop == AdvectionStop::kWedge || line.stop == AdvectionStop::kTrisector;
     if (at_point && options_.topology_routing) {
@@ -615,7 +619,7 @@ StepOutput RobotPlanner::Step(const FloorInput& floor, const RobotInput& robot, 
         route_ = std::move(r);
         std::vector<float> speeds(route_->polyline.size(), static_cast<float>(options_.speed_mps));
         out.diag.mode = StepMode::kSeparatrix;
-        EmitLine(route_->polyline, speeds, robot, gain, &out);
+        EmitLine(route_->polyline, speeds, robot, gain, true, &out);
         return finish();
       }
     }
@@ -651,7 +655,7 @@ StepOutput RobotPlanner::Step(const FloorInput& floor, const RobotInput& robot, 
       history_.push_back(robot.position_m);
       std::vector<float> speeds(route_->polyline.size(), static_cast<float>(options_.speed_mps));
       out.diag.mode = StepMode::kSkeleton;
-      EmitLine(route_->polyline, speeds, robot, gain, &out);
+      EmitLine(route_->polyline, speeds, robot, gain, true, &out);
       return finish();
     }
   }
@@ -659,7 +663,7 @@ StepOutput RobotPlanner::Step(const FloorInput& floor, const RobotInput& robot, 
     no_gain_streak_ = 0;
     std::vector<float> speeds(route_->polyline.size(), static_cast<float>(options_.speed_mps));
     out.diag.mode = StepMode::kFrontier;
-    EmitLine(route_->polyline, speeds, robot, gain, &out);
+    EmitLine(route_->polyline, speeds, robot, gain, true, &out);
     return finish();
   }
   if (line.Length() >= 1e-3) {
@@ -670,7 +674,7 @@ StepOutput RobotPlanner::Step(const FloorInput& floor, const RobotInput& robot, 
       speeds.push_back(static_cast<float>(std::max(p.speed_mps, 0.05)));
     }
     out.diag.mode = StepMode::kAdvect;
-    EmitLine(xy, speeds, robot, gain, &out);
+    EmitLine(xy, speeds, robot, gain, readvected, &out);
   }
   return finish();
 }

@@ -34,6 +34,9 @@ class ViewGain;  // gain.h
 // (potential_info.h).
 enum class Method : std::uint8_t { kTensor = 0, kHarmonic = 1, kPotential = 2 };
 
+// How a new camera trajectory starts (PlannerOptions::connect).
+enum class CameraConnect : std::uint8_t { kOff = 0, kSpline = 1, kInSelection = 2 };
+
 struct PlannerOptions {
   Method method = Method::kTensor;
   // With kTensor: the paper's tensor field, or a vector-field baseline from the same constraints
@@ -52,6 +55,18 @@ struct PlannerOptions {
   // trisectors off obstacles (topology_control.h).
   bool topology_control = false;
   CameraMode camera = CameraMode::kOptimized;
+  // X12 (X L310): where the path ahead runs into unknown space (the robot's body, radius +
+  // clearance_margin_m around it, meets unknown cells), a look-at view towards it at the camera
+  // samples within lookat_m of it, and eq. 8's look-at term with weight lookat_weight (ω_U).
+  bool lookat = true;
+  double lookat_m = 2.0;
+  double lookat_weight = 1.0;
+  // X5 (X L194): kSpline, every camera trajectory starts where the camera is and is joined to the
+  // optimised one by a connecting stretch under the camera's speed limits
+  // (ConnectCameraTrajectory); kInSelection [ours], eq. 8 itself starts from the camera's pose
+  // (CameraPathParams::start_from_camera), then the same connection; kOff, it starts at the
+  // optimised trajectory's first view and the host turns the camera there at its joints' rate.
+  CameraConnect connect = CameraConnect::kSpline;
   double gain_threshold = 0.01;      // X L229
   double clearance_margin_m = 0.05;  // beyond the robot radius, as the host's own routes keep
   double lookahead_m = 2.0;          // the pathline the camera is planned along
@@ -79,6 +94,12 @@ struct RobotInput {
   bool arm = false;  // camera on an arm (its workspace below), else a head over the base
   CameraWorkspace workspace;
   double min_pitch_rad = -0.5, max_pitch_rad = 0.5;
+  // Where the camera looks now (world yaw: the base's heading plus the camera joint's yaw).
+  double camera_yaw_rad = 0.0, camera_pitch_rad = 0.0;
+  // The camera's speed limits on its mount (v_m, a_m: the arm's speed, the slower camera joint)
+  // and the base's turn rate in place.
+  CameraSpeedLimits camera_limits;
+  double turn_rate_radps = 1.0;
 };
 
 // The host's geodesic queries (empty functions in unit tests: every frontier counts as
@@ -132,6 +153,19 @@ struct StepDiagnostics {
   int census_degenerate = -1, census_vector_normal = -1, census_vector_tangent = -1;
   double census_ms = -1.0;
   double control_ms = -1.0;  // key-frame calls: topology control (0 when off)
+  // X12 (this call): camera samples with a look-at target, those whose selected view sees it,
+  // those whose view the look-at changed; the robot's distance to the nearest target (-1: none).
+  int lookat_samples = 0, lookat_seen = 0, lookat_changed = 0;
+  double lookat_m = -1.0;
+  // X5: this call is a stop (a new kind of path, a re-advection at a wedge, trisector or
+  // obstacle, a route started, a first piece the base turns in place for, or a path after none);
+  // the stops so far; the camera's jump to the optimised trajectory's start (degrees); the
+  // camera's largest angular speed over the connecting stretch without and with the connection
+  // (rad/s; without: the jump taken in the first step); the stretch (s, 0 when not connected).
+  bool camera_stop = false;
+  int camera_stops = 0;
+  double camera_jump_deg = 0.0, camera_radps_before = 0.0, camera_radps_after = 0.0;
+  double camera_connect_s = 0.0;
 };
 
 struct StepOutput {
@@ -192,8 +226,14 @@ class RobotPlanner {
   bool Settled(const FloorInput& floor, int cell) const;
   Key KeyOf(const omt::RasterGeometry& g, int cell) const;
   bool Stuck() const;
+  // stop: the caller knows this call is a stop (a route or a re-advection starts); EmitLine adds
+  // the other kinds (StepDiagnostics::camera_stop).
   void EmitLine(const std::vector<Eigen::Vector2d>& line, const std::vector<float>& speeds,
-                const RobotInput& robot, const ViewGain& gain, StepOutput* out);
+                const RobotInput& robot, const ViewGain& gain, bool stop, StepOutput* out);
+  std::vector<CameraLookAtTarget> LookAtTargets(const std::vector<Eigen::Vector2d>& line,
+                                                const RobotInput& robot) const;
+  // Where the arm camera is now by the last trajectory sent (NaN: not known).
+  Eigen::Vector3f ArmCameraNow(const RobotInput& robot) const;
 
   PlannerOptions options_;
   // Key frames and the frames between them.
@@ -228,6 +268,14 @@ class RobotPlanner {
   static constexpr double kTrailSpacingM = 0.25, kVisitRadiusM = 1.0;
   std::vector<Eigen::Vector2d> trail_;
   std::vector<Eigen::Vector2d> skeleton_goals_;  // edge points routed to: not targets again
+  // X5: what the last call emitted (kNone: nothing) and this call's; the stops so far; the path
+  // and camera trajectory last sent (the path's arc length and time at each point), for where
+  // the arm camera is now.
+  StepMode prev_mode_ = StepMode::kNone, emitted_mode_ = StepMode::kNone;
+  int camera_stops_ = 0;
+  std::vector<Eigen::Vector2d> sent_path_;
+  std::vector<double> sent_arc_, sent_time_;
+  std::vector<CameraOut> sent_camera_;
 };
 
 }  // namespace voxplan::tensorfield

@@ -44,6 +44,13 @@ PlannerOptions ReadOptions(const std::string& json_text) {
              : camera == "no_linear"  ? CameraMode::kNoLinear
              : camera == "no_angular" ? CameraMode::kNoAngular
                                       : CameraMode::kOptimized;
+  o.lookat = json.Flag("lookat", o.lookat);
+  o.lookat_m = json.Number("lookat_m", o.lookat_m, 0.1, 10.0);
+  o.lookat_weight = json.Number("lookat_weight", o.lookat_weight, 0.0, 100.0);
+  const std::string connect = json.Choice("connect", "spline", {"spline", "selection", "off"});
+  o.connect = connect == "off"         ? CameraConnect::kOff
+              : connect == "selection" ? CameraConnect::kInSelection
+                                       : CameraConnect::kSpline;
   o.gain_threshold = json.Number("gain_threshold", o.gain_threshold, 0.0, 1.0);
   const std::string field =
       json.Choice("field", "tensor", {"tensor", "vector_normal", "vector_tangent"});
@@ -87,7 +94,19 @@ RobotInput ReadRobot(const vp::WorldView& world, uint32_t r, const vp_map_info& 
   in.floor_z_m = map.floor_z_m;
   in.min_pitch_rad = robot.min_pitch_rad;
   in.max_pitch_rad = robot.max_pitch_rad;
+  in.camera_yaw_rad = double(robot.theta_rad) + double(robot.camera_yaw_rad);
+  in.camera_pitch_rad = robot.camera_pitch_rad;
+  // a_m: the slower camera joint (the mode says so; else the robot's joint rates).
+  const float joints = std::min(robot.camera_yaw_rate_radps, robot.camera_pitch_rate_radps);
+  if (mode.camera_turn_rate_radps > 0.f) {
+    in.camera_limits.angular_radps = mode.camera_turn_rate_radps;
+  } else if (joints > 0.f) {
+    in.camera_limits.angular_radps = joints;
+  }
+  if (mode.max_turn_rate_radps > 0.f) in.turn_rate_radps = mode.max_turn_rate_radps;
   in.arm = mode.mount == VP_MOUNT_ARM;
+  // v_m: the arm's speed on its mount (a head moves with the base: the paper's v_m).
+  if (in.arm && mode.camera_speed_mps > 0.f) in.camera_limits.linear_mps = mode.camera_speed_mps;
   if (in.arm) {
     in.workspace.height_min_m = mode.camera_height_min_m;
     in.workspace.height_max_m = mode.camera_height_max_m;
@@ -193,6 +212,20 @@ class TensorfieldPlanner : public vp::Planner {
       out.Diagnostic("moved_trisectors" + s, d.moved_trisectors);
     }
     out.Diagnostic("settled_goals" + s, d.settled_goals);
+    if (options_.lookat && options_.camera != CameraMode::kFixed) {
+      out.Diagnostic("lookat_samples" + s, d.lookat_samples);
+      out.Diagnostic("lookat_seen" + s, d.lookat_seen);
+      out.Diagnostic("lookat_changed" + s, d.lookat_changed);
+      out.Diagnostic("lookat_m" + s, d.lookat_m);
+    }
+    if (options_.camera != CameraMode::kFixed) {
+      out.Diagnostic("camera_stop" + s, d.camera_stop ? 1.0 : 0.0);
+      out.Diagnostic("camera_stops" + s, d.camera_stops);
+      out.Diagnostic("camera_jump_deg" + s, d.camera_jump_deg);
+      out.Diagnostic("camera_radps_before" + s, d.camera_radps_before);
+      out.Diagnostic("camera_radps_after" + s, d.camera_radps_after);
+      out.Diagnostic("camera_connect_s" + s, d.camera_connect_s);
+    }
     out.Diagnostic("mode" + s, double(d.mode));
     out.Diagnostic("stop" + s, d.stop);
     const float z = float(robot.camera_height_m) + map.floor_z_m;

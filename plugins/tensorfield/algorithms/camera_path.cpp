@@ -43,7 +43,8 @@ struct Chain {
   std::vector<int> sample;  // path sample index of each link
   std::vector<double> time_s;
   std::vector<std::vector<Eigen::Vector3d>> q;
-  std::vector<std::vector<double>> yaw, pitch, unary;  // unary: −ω_V V̂
+  std::vector<std::vector<double>> yaw, pitch, unary;  // unary: −ω_V V̂ − ω_U U
+  std::vector<std::vector<double>> gain, lookat;       // its −ω_V V̂ and −ω_U U parts
 };
 
 struct Terms {
@@ -86,11 +87,18 @@ Chain MakeChain(std::span<const double> times_s,
     auto& yaw = ch.yaw.emplace_back();
     auto& pitch = ch.pitch.emplace_back();
     auto& unary = ch.unary.emplace_back();
+    auto& gain = ch.gain.emplace_back();
+    auto& lookat = ch.lookat.emplace_back();
     for (const CameraCandidate& c : candidates[s]) {
       q.push_back(c.position_W.cast<double>());
       yaw.push_back(c.yaw_rad);
       pitch.push_back(c.pitch_rad);
-      unary.push_back(-p.weight_gain * t.gain_scale * double{c.gain});
+      const double v = -p.weight_gain * t.gain_scale * double{c.gain};
+      // Without U the unary is bit for bit what it was before X12.
+      const double u = c.lookat != 0.0f ? -p.weight_lookat * double{c.lookat} : 0.0;
+      gain.push_back(v);
+      lookat.push_back(u);
+      unary.push_back(u != 0.0 ? v + u : v);
     }
   }
   return ch;
@@ -386,7 +394,8 @@ CameraSelection EvaluateCameraSelection(std::span<const double> times_s,
   CameraSelectionEnergy& e = out.energy;
   auto x = [&](int m) { return sel[static_cast<std::size_t>(m)]; };
   for (int m = 0; m < n; ++m) {
-    e.gain += ch.unary[static_cast<std::size_t>(m)][static_cast<std::size_t>(x(m))];
+    e.gain += ch.gain[static_cast<std::size_t>(m)][static_cast<std::size_t>(x(m))];
+    e.lookat += ch.lookat[static_cast<std::size_t>(m)][static_cast<std::size_t>(x(m))];
     if (m >= 1 && params.limit_adjacent_steps)
       e.penalty += speed(m - 1, x(m - 1), m, x(m), &out.linear_violations, &out.angular_violations);
     if (m >= 2) {
@@ -395,7 +404,7 @@ CameraSelection EvaluateCameraSelection(std::span<const double> times_s,
       e.penalty += speed(m - 2, x(m - 2), m, x(m), &out.linear_violations, &out.angular_violations);
     }
   }
-  e.total = e.gain + e.linear + e.angular;
+  e.total = e.gain + e.linear + e.angular + e.lookat;
   out.feasible = out.linear_violations == 0 && out.angular_violations == 0;
   return out;
 }
@@ -515,10 +524,226 @@ CameraTrajectory InterpolateCameraPath(std::span<const CameraBaseSample> path,
   return out;
 }
 
+std::vector<CameraLookAtTarget> FindLookAtTargets(std::span<const Eigen::Vector2f> line,
+                                                  float touch_m, float step_m, float height_m,
+                                                  const NearestUnknownFn& nearest_unknown) {
+  std::vector<CameraLookAtTarget> out;
+  if (line.empty() || !nearest_unknown) return out;
+  const float step = std::max(step_m, 1e-3f);
+  auto visit = [&](const Eigen::Vector2f& p, float arc) {
+    const std::optional<Eigen::Vector2f> u = nearest_unknown(p, touch_m);
+    if (!u || !u->allFinite()) return;
+    const Eigen::Vector3f point(u->x(), u->y(), height_m);
+    if (!out.empty() && out.back().point_W == point) return;
+    out.push_back({point, arc});
+  };
+  visit(line[0], 0.0f);
+  float arc = 0.0f;
+  for (std::size_t i = 1; i < line.size(); ++i) {
+    const Eigen::Vector2f a = line[i - 1], b = line[i];
+    const float len = (b - a).norm();
+    const int pieces = std::max(1, static_cast<int>(std::ceil(len / step - 1e-4f)));
+    for (int k = 1; k <= pieces; ++k) {
+      const float f = static_cast<float>(k) / static_cast<float>(pieces);
+      visit(a + f * (b - a), arc + f * len);
+    }
+    arc += len;
+  }
+  return out;
+}
+
+std::vector<int> AssignLookAtTargets(std::span<const CameraBaseSample> path,
+                                     std::span<const CameraLookAtTarget> targets, float range_m) {
+  std::vector<int> out(path.size(), -1);
+  constexpr float kArcTolM = 1e-4f;
+  for (std::size_t s = 0; s < path.size(); ++s) {
+    for (std::size_t k = 0; k < targets.size(); ++k) {
+      if (targets[k].arc_length_m < path[s].arc_length_m - kArcTolM) continue;
+      if ((targets[k].point_W.head<2>() - path[s].xy_m).norm() < range_m) {
+        out[s] = static_cast<int>(k);
+        break;
+      }
+    }
+  }
+  return out;
+}
+
+float LookAtScore(const Eigen::Vector3f& camera_W, float yaw_rad, const Eigen::Vector3f& target_W,
+                  float half_fov_rad) {
+  const Eigen::Vector2f d = target_W.head<2>() - camera_W.head<2>();
+  if (d.squaredNorm() < 1e-12f) return 1.0f;
+  const float bearing = std::atan2(d.y(), d.x());
+  return std::abs(WrapPiF(bearing - yaw_rad)) <= half_fov_rad ? 1.0f : 0.0f;
+}
+
+void AddLookAtViews(std::span<const CameraBaseSample> path, const CameraLookAt& lookat,
+                    std::span<const int> target_of_sample,
+                    std::vector<std::vector<CameraCandidate>>* candidates) {
+  const std::size_t n = std::min({path.size(), target_of_sample.size(), candidates->size()});
+  for (std::size_t s = 0; s < n; ++s) {
+    const int k = target_of_sample[s];
+    std::vector<CameraCandidate>& cs = (*candidates)[s];
+    if (k < 0 || k >= static_cast<int>(lookat.targets.size()) || cs.empty()) continue;
+    const Eigen::Vector3f& target = lookat.targets[static_cast<std::size_t>(k)].point_W;
+    std::size_t nearest = 0;
+    for (std::size_t i = 0; i < cs.size(); ++i) {
+      cs[i].lookat =
+          LookAtScore(cs[i].position_W, cs[i].yaw_rad, target, lookat.params.half_fov_rad);
+      if ((cs[i].position_W - target).head<2>().norm() <
+          (cs[nearest].position_W - target).head<2>().norm())
+        nearest = i;
+    }
+    CameraCandidate v = cs[nearest];
+    const Eigen::Vector2f d = target.head<2>() - v.position_W.head<2>();
+    v.yaw_rad = d.squaredNorm() > 1e-12f ? std::atan2(d.y(), d.x()) : path[s].heading_rad;
+    v.pitch_rad = 0.0f;
+    const float g = lookat.gain ? lookat.gain(v.position_W, v.yaw_rad, v.pitch_rad, path[s]) : 0.0f;
+    v.gain = std::isfinite(g) ? g : 0.0f;
+    v.lookat = 1.0f;
+    v.lookat_view = true;
+    cs.push_back(v);
+  }
+}
+
+namespace {
+
+// The trajectory's pose at time t (linear between its samples, yaw the short way; held outside).
+struct PoseAt {
+  Eigen::Vector3f q;
+  float yaw, pitch;
+};
+PoseAt TrajectoryAt(const std::vector<CameraPathSample>& tr, float t) {
+  if (t <= tr.front().time_s)
+    return {tr.front().position_W, tr.front().yaw_rad, tr.front().pitch_rad};
+  for (std::size_t i = 1; i < tr.size(); ++i) {
+    if (t > tr[i].time_s) continue;
+    const float span = tr[i].time_s - tr[i - 1].time_s;
+    const float a = span > 0.0f ? (t - tr[i - 1].time_s) / span : 1.0f;
+    return {tr[i - 1].position_W + a * (tr[i].position_W - tr[i - 1].position_W),
+            WrapPiF(tr[i - 1].yaw_rad + a * WrapPiF(tr[i].yaw_rad - tr[i - 1].yaw_rad)),
+            tr[i - 1].pitch_rad + a * (tr[i].pitch_rad - tr[i - 1].pitch_rad)};
+  }
+  return {tr.back().position_W, tr.back().yaw_rad, tr.back().pitch_rad};
+}
+
+float TurnBetween(float yaw_a, float pitch_a, float yaw_b, float pitch_b) {
+  return std::hypot(WrapPiF(yaw_b - yaw_a), pitch_b - pitch_a);
+}
+
+}  // namespace
+
+CameraConnection ConnectCameraTrajectory(const CameraPose& from, const CameraConnectParams& p,
+                                         CameraTrajectory* trajectory) {
+  CameraConnection out;
+  std::vector<CameraPathSample>& tr = trajectory->samples;
+  if (tr.empty() || !std::isfinite(from.yaw_rad) || !std::isfinite(from.pitch_rad)) return out;
+  const bool has_q = from.position_W.allFinite();
+  const float t0 = tr.front().time_s;
+  const float hold = std::max(0.0f, p.hold_s);
+  const float v_max = std::max(1e-6f, p.limits.linear_mps);
+  const float a_max = std::max(1e-6f, p.limits.angular_radps);
+  // The difference to fade out: from the pose to the trajectory where the hold ends.
+  const PoseAt join = TrajectoryAt(tr, t0 + hold);
+  const float d_yaw = WrapPiF(from.yaw_rad - join.yaw);
+  const float d_pitch = from.pitch_rad - join.pitch;
+  const Eigen::Vector3f d_q =
+      has_q ? Eigen::Vector3f(from.position_W - join.q) : Eigen::Vector3f::Zero();
+  out.jump_rad =
+      TurnBetween(from.yaw_rad, from.pitch_rad, tr.front().yaw_rad, tr.front().pitch_rad);
+  out.jump_m = has_q ? (from.position_W - tr.front().position_W).norm() : 0.0f;
+  constexpr float kSameRad = 1e-4f, kSameM = 1e-4f;
+  // The smoothstep's steepest slope is 1.5 / blend.
+  const float share = std::clamp(p.rate_share, 1e-3f, 1.0f);
+  const float blend = std::max({p.min_s, 1.5f * std::hypot(d_yaw, d_pitch) / (share * a_max),
+                                1.5f * d_q.norm() / (share * v_max)});
+  out.duration_s = hold + blend;
+  const float end_t = t0 + out.duration_s;
+  // The speeds before: the trajectory as given, its first step taking the jump.
+  auto step_speeds = [&](const std::vector<CameraPathSample>& samples, float* radps, float* mps,
+                         bool from_pose) {
+    *radps = *mps = 0.0f;
+    for (std::size_t k = 1; k < samples.size() && samples[k - 1].time_s < end_t; ++k) {
+      const float dt = std::max(samples[k].time_s - samples[k - 1].time_s, 1e-6f);
+      const bool first = k == 1 && from_pose;
+      const float yaw_a = first ? from.yaw_rad : samples[k - 1].yaw_rad;
+      const float pitch_a = first ? from.pitch_rad : samples[k - 1].pitch_rad;
+      *radps = std::max(*radps,
+                        TurnBetween(yaw_a, pitch_a, samples[k].yaw_rad, samples[k].pitch_rad) / dt);
+      if (has_q) {
+        const Eigen::Vector3f qa = first ? from.position_W : samples[k - 1].position_W;
+        *mps = std::max(*mps, (samples[k].position_W - qa).norm() / dt);
+      }
+    }
+  };
+  step_speeds(tr, &out.max_radps_before, &out.max_mps_before, true);
+  if (std::hypot(d_yaw, d_pitch) <= kSameRad && d_q.norm() <= kSameM && out.jump_rad <= kSameRad &&
+      out.jump_m <= kSameM) {
+    out.max_radps_after = out.max_radps_before;
+    out.max_mps_after = out.max_mps_before;
+    return out;
+  }
+  out.connected = true;
+  CameraPathSample prev;
+  for (std::size_t k = 0; k < tr.size(); ++k) {
+    CameraPathSample& c = tr[k];
+    const float tau = c.time_s - t0 - hold;
+    if (tau <= 0.0f) {
+      c.yaw_rad = from.yaw_rad;
+      c.pitch_rad = from.pitch_rad;
+      if (has_q) c.position_W = from.position_W;
+    } else if (tau < blend) {
+      const float x = tau / blend;
+      const float keep = 1.0f - x * x * (3.0f - 2.0f * x);
+      c.yaw_rad = WrapPiF(c.yaw_rad + keep * d_yaw);
+      c.pitch_rad += keep * d_pitch;
+      if (has_q) c.position_W += keep * d_q;
+    }
+    if (has_q) {
+      const Eigen::Vector3f r =
+          ClampToCameraWorkspace(c.position_W, c.base, p.workspace, p.floor_z_m);
+      if ((r - c.position_W).norm() > kClampTolM) ++out.workspace_clamps;
+      c.position_W = r;
+    }
+    if (k > 0) {
+      // The forward pass: a step over a limit is shortened; the samples after catch up.
+      const float dt = std::max(c.time_s - prev.time_s, 0.0f);
+      if (has_q) {
+        const float step_max = v_max * dt;
+        const Eigen::Vector3f step = c.position_W - prev.position_W;
+        const float len = step.norm();
+        if (len > step_max * (1.0f + 1e-6f) + 1e-7f) {
+          c.position_W = ClampToCameraWorkspace(prev.position_W + step * (step_max / len), c.base,
+                                                p.workspace, p.floor_z_m);
+          ++out.speed_clamps;
+        }
+      }
+      const float turn_max = a_max * dt;
+      const float dy = WrapPiF(c.yaw_rad - prev.yaw_rad), dp = c.pitch_rad - prev.pitch_rad;
+      const float turn = std::hypot(dy, dp);
+      if (turn > turn_max * (1.0f + 1e-6f) + 1e-7f) {
+        const float f = turn_max / turn;
+        c.yaw_rad = WrapPiF(prev.yaw_rad + f * dy);
+        c.pitch_rad = prev.pitch_rad + f * dp;
+        ++out.speed_clamps;
+      }
+    }
+    prev = c;
+  }
+  step_speeds(tr, &out.max_radps_after, &out.max_mps_after, true);
+  return out;
+}
+
 CameraPathResult PlanCameraPath(std::span<const CameraBaseSample> path,
                                 const CameraPathParams& params, const CameraFreeFn& free,
                                 const CameraScoreFn& score) {
+  return PlanCameraPath(path, params, free, score, CameraLookAt{});
+}
+
+CameraPathResult PlanCameraPath(std::span<const CameraBaseSample> path,
+                                const CameraPathParams& params, const CameraFreeFn& free,
+                                const CameraScoreFn& score, const CameraLookAt& lookat) {
   CameraPathResult out;
+  out.lookat_target.assign(path.size(), -1);
   out.mode = params.mode;
   const CameraWorkspace& ws = params.candidates.workspace;
   const float floor_z = params.candidates.floor_z_m;
@@ -567,7 +792,47 @@ CameraPathResult PlanCameraPath(std::span<const CameraBaseSample> path,
   if (params.mode == CameraMode::kNoLinear) sp.weight_linear = 0.0;
   if (params.mode == CameraMode::kNoAngular) sp.weight_angular = 0.0;
   out.candidates = SampleCameraCandidates(path, params.candidates, free, score);
+  std::vector<std::vector<CameraCandidate>> plain;  // without X12, for lookat_changed
+  if (!lookat.targets.empty()) {
+    out.lookat_target = AssignLookAtTargets(path, lookat.targets, lookat.params.range_m);
+    if (std::any_of(out.lookat_target.begin(), out.lookat_target.end(),
+                    [](int k) { return k >= 0; })) {
+      plain = out.candidates;
+      AddLookAtViews(path, lookat, out.lookat_target, &out.candidates);
+    }
+  }
+  if (params.start_from_camera) {
+    const auto pin = [&](std::vector<std::vector<CameraCandidate>>* cands) {
+      if (cands->empty() || (*cands)[0].empty()) return;
+      CameraCandidate c = (*cands)[0][0];
+      if (params.start_position_W.allFinite()) c.position_W = params.start_position_W;
+      c.yaw_rad = WrapPiF(params.start_yaw_rad);
+      c.pitch_rad = params.start_pitch_rad;
+      c.gain = 0.0f;
+      const int k = out.lookat_target.empty() ? -1 : out.lookat_target[0];
+      c.lookat = k >= 0 && !plain.empty()
+                     ? LookAtScore(c.position_W, c.yaw_rad,
+                                   lookat.targets[static_cast<std::size_t>(k)].point_W,
+                                   lookat.params.half_fov_rad)
+                     : 0.0f;
+      c.lookat_view = false;
+      (*cands)[0] = {c};
+    };
+    pin(&out.candidates);
+    if (!plain.empty()) pin(&plain);
+  }
   out.selection = SelectCameraViews(times, out.candidates, sp);
+  if (!plain.empty()) {
+    const CameraSelection without = SelectCameraViews(times, plain, sp);
+    for (std::size_t s = 0; s < path.size(); ++s) {
+      const int x = out.selection.selected[s];
+      if (out.lookat_target[s] < 0 || x < 0) continue;
+      ++out.lookat_samples;
+      const CameraCandidate& c = out.candidates[s][static_cast<std::size_t>(x)];
+      out.lookat_seen += c.lookat > 0.0f ? 1 : 0;
+      out.lookat_changed += c.lookat_view || x != without.selected[s] ? 1 : 0;
+    }
+  }
   std::vector<const CameraCandidate*> views(path.size(), nullptr);
   for (std::size_t s = 0; s < path.size(); ++s) {
     const int x = out.selection.selected[s];

@@ -8,10 +8,18 @@
 // chain over (s-1, s, s+1), so a dynamic programme over candidate pairs (x_{s-1}, x_s) solves it
 // exactly in O(S·C³). Plain data and callbacks (free space, view scoring): the map is the
 // planner's. Deterministic; nothing is printed.
+//
+// Two parts of the paper outside eq. 8 are here too. X12 (X L310): where the path runs into
+// unknown space, a look-at view towards it is added to the path samples within 2 m of it, and a
+// view that sees it earns eq. 8 a unary term (FindLookAtTargets, PlanCameraPath's CameraLookAt).
+// X5 (X L194): a new trajectory starts from where the camera is, joined to the optimised one by
+// a connecting stretch under the speed limits (ConnectCameraTrajectory).
 #pragma once
 
 #include <Eigen/Core>
 #include <functional>
+#include <limits>
+#include <optional>
 #include <span>
 #include <vector>
 
@@ -51,11 +59,14 @@ struct CameraViewScore {
 // True when the camera may be at camera_W (the planner: a free voxel of the map, X L310).
 // An empty function accepts every position.
 using CameraFreeFn = std::function<bool(const Eigen::Vector3f& camera_W)>;
-// Best view and gain at camera_W, with the base sample it belongs to (a planner can add a look-at
-// towards unknown space near the path, X L308). An empty function looks along the heading with
-// gain 0.
+// Best view and gain at camera_W, with the base sample it belongs to. An empty function looks
+// along the heading with gain 0.
 using CameraScoreFn =
     std::function<CameraViewScore(const Eigen::Vector3f& camera_W, const CameraBaseSample& base)>;
+// The gain V of the view from camera_W along a given direction (X12's added look-at view, whose
+// direction is set by its target rather than by the gain). An empty function gives 0.
+using CameraDirectionGainFn = std::function<float(const Eigen::Vector3f& camera_W, float yaw_rad,
+                                                  float pitch_rad, const CameraBaseSample& base)>;
 
 // "fixed": camera rigidly forward at a set height, nothing optimised (the baselines' setting,
 // X L429); "no_linear" / "no_angular": ω_L = 0 / ω_A = 0 (the camera ablations, Fig. 12, 18).
@@ -75,6 +86,12 @@ struct CameraCandidateParams {
 struct CameraSelectionParams {
   CameraSpeedLimits limits;
   float base_speed_mps = 0.3f;  // X L304: 0.3 m/s; the time between samples is Δs / base speed
+  // X12's look-at term [ours: the paper adds the view and says it "ensures that the robot looks
+  // into that region", X L310, without a weight]: −ω_U Σ U, U the candidate's lookat (1 when its
+  // view sees the sample's look-at target). With ω_U = ω_V a view that sees the target never
+  // scores below one that does not on the unary terms alone; smoothness and the speed limits can
+  // still keep the camera away. No effect where no candidate has U > 0.
+  double weight_lookat = 1.0;
   // Eq. 8's weights (silent in the paper; planner-wave.md §2.4 [ours]). Each term is normalised
   // per sample so the weights compare O(1) quantities: a gain is divided by the largest candidate
   // gain on the path (V̂ in [0, 1]); a position second difference ‖q_{s-1} − 2q_s + q_{s+1}‖ by
@@ -115,6 +132,14 @@ struct CameraPathParams {
   float fixed_forward_m = 0.5f;
   float fixed_height_m = 0.9f;
   float fixed_pitch_rad = 0.0f;
+  // X5 inside eq. 8 [ours]: the first path sample's only candidate is the camera's pose now (its
+  // position where known, else that of the sample's first candidate), so the selection's speed
+  // limits and smoothness run on from where the camera is. Not in "fixed".
+  bool start_from_camera = false;
+  Eigen::Vector3f start_position_W =
+      Eigen::Vector3f::Constant(std::numeric_limits<float>::quiet_NaN());
+  float start_yaw_rad = 0.0f;
+  float start_pitch_rad = 0.0f;
 };
 
 struct CameraCandidate {
@@ -126,6 +151,10 @@ struct CameraCandidate {
   float reach_m = 0.0f;
   float bearing_rad = 0.0f;  // relative to the heading, positive to the left
   float height_m = 0.0f;
+  // X12: U in [0, 1], 1 when the view sees its sample's look-at target (LookAtScore); 0 where
+  // the sample has none. lookat_view: the view X12 added, aimed at the target.
+  float lookat = 0.0f;
+  bool lookat_view = false;
 };
 
 // Eq. 8's terms for a selection, as weighted and normalised (CameraSelectionParams).
@@ -133,7 +162,8 @@ struct CameraSelectionEnergy {
   double gain = 0.0;     // −ω_V Σ V̂
   double linear = 0.0;   // ω_L Σ ‖Δ²q‖² / (v_m Δt̄)²
   double angular = 0.0;  // ω_A Σ ‖Δ²α‖² / (a_m Δt̄)², yaw differences wrapped
-  double total = 0.0;    // gain + linear + angular
+  double lookat = 0.0;   // −ω_U Σ U (X12)
+  double total = 0.0;    // gain + linear + angular + lookat
   double penalty = 0.0;  // speed violations (0 when feasible)
 };
 
@@ -166,13 +196,119 @@ struct CameraTrajectory {
   int speed_violations = 0;      // steps still over a limit after clamping (Ψ wins over speed)
 };
 
+// X12 (X L308-310): "a path may stretch into an unknown region in which an obstacle could block
+// the path. If such a case is detected, we add a look-at view pointing towards the unknown
+// region, to the path samples near that region (< 2m), during the camera trajectory
+// optimization. This ensures that the robot looks into that region before rushing into it."
+struct CameraLookAtTarget {
+  Eigen::Vector3f point_W = Eigen::Vector3f::Zero();  // a point of the unknown region
+  float arc_length_m = 0.0f;                          // where along the base path the path meets it
+};
+
+struct CameraLookAtParams {
+  float range_m = 2.0f;  // X L310: the samples nearer than this (horizontally) to the target
+  // A view sees a target whose horizontal bearing from the camera lies within this of its yaw:
+  // half the horizontal field of view (29°, half a Kinect v1's 58°; the planner passes its mode's).
+  float half_fov_rad = 0.5061455f;
+};
+
+struct CameraLookAt {
+  std::vector<CameraLookAtTarget> targets;  // by non-decreasing arc length; empty: X12 is off
+  CameraLookAtParams params;
+  CameraDirectionGainFn gain;  // the added view's V
+};
+
 struct CameraPathResult {
   CameraMode mode = CameraMode::kOptimized;
   // Per path sample; in "fixed" the one rigid pose (free space not asked, gain 0).
   std::vector<std::vector<CameraCandidate>> candidates;
   CameraSelection selection;
   CameraTrajectory trajectory;
+  // X12, per path sample: the index of its look-at target (−1 none); and the counts: samples
+  // with a target (and candidates), those whose selected view sees it, and those whose selected
+  // view differs from the selection eq. 8 makes without the look-at views and term.
+  std::vector<int> lookat_target;
+  int lookat_samples = 0;
+  int lookat_seen = 0;
+  int lookat_changed = 0;
 };
+
+// X12's detection along a base path (world xy polyline), walked every step_m: each point where
+// the robot's body, touch_m around the path, meets unknown space (nearest_unknown(p, touch_m):
+// the nearest unknown point within touch_m of p, nullopt for none) gives a target there at
+// height_m, keyed by the point's arc length; a target equal to the one before is not repeated.
+using NearestUnknownFn =
+    std::function<std::optional<Eigen::Vector2f>(const Eigen::Vector2f& p, float within_m)>;
+std::vector<CameraLookAtTarget> FindLookAtTargets(std::span<const Eigen::Vector2f> line,
+                                                  float touch_m, float step_m, float height_m,
+                                                  const NearestUnknownFn& nearest_unknown);
+
+// Per path sample: the first target at or ahead of its arc length (the region it is about to
+// rush into) that lies within range_m of its base position, horizontally; −1 for none.
+std::vector<int> AssignLookAtTargets(std::span<const CameraBaseSample> path,
+                                     std::span<const CameraLookAtTarget> targets, float range_m);
+
+// X12's U: 1 when the view from camera_W along yaw_rad sees target_W (its horizontal bearing
+// within half_fov_rad of the yaw; a target at the camera counts as seen), else 0.
+float LookAtScore(const Eigen::Vector3f& camera_W, float yaw_rad, const Eigen::Vector3f& target_W,
+                  float half_fov_rad);
+
+// X12 on sampled candidates: at every sample with a target (target_of_sample, −1 none) and at
+// least one candidate, U of each candidate, and one more view appended, the look-at view: at the
+// position of the sample's candidate nearest the target (in Ψ and free), looking at it level
+// (pitch 0), its gain from lookat.gain.
+void AddLookAtViews(std::span<const CameraBaseSample> path, const CameraLookAt& lookat,
+                    std::span<const int> target_of_sample,
+                    std::vector<std::vector<CameraCandidate>>* candidates);
+
+// X5 (X L194): "At the wedge, both robot path and camera trajectory are replanned, thus
+// splitting the path and trajectory at the point. During the stop, the robot computes a smooth
+// connecting trajectory, to smoothly transit between the two separate camera trajectories."
+// Where the camera is when a new trajectory starts.
+struct CameraPose {
+  // NaN: not known (a head, whose position is the base's; no earlier trajectory): the
+  // trajectory's positions are kept.
+  Eigen::Vector3f position_W = Eigen::Vector3f::Constant(std::numeric_limits<float>::quiet_NaN());
+  float yaw_rad = 0.0f;  // world
+  float pitch_rad = 0.0f;
+};
+
+struct CameraConnectParams {
+  CameraWorkspace workspace;
+  CameraSpeedLimits limits;
+  float floor_z_m = 0.0f;
+  // The camera holds its pose for hold_s first (the host turning the base in place, the camera
+  // carried round with it), then blends into the trajectory over a stretch at least min_s long,
+  // and long enough that the blend alone turns and moves the camera at most at rate_share of each
+  // limit (the rest is the trajectory's own motion).
+  float hold_s = 0.0f;
+  float min_s = 1.0f;
+  float rate_share = 0.5f;
+};
+
+struct CameraConnection {
+  bool connected = false;   // the trajectory was changed
+  float jump_rad = 0.0f;    // ‖(Δyaw, Δpitch)‖ from the pose to the trajectory's start
+  float jump_m = 0.0f;      // from the pose's position (0 when not known)
+  float duration_s = 0.0f;  // hold + blend
+  // The largest angular (linear) step speed over the connecting stretch: before, of the
+  // trajectory as given with the jump from the pose taken in its first step; after, as connected.
+  float max_radps_before = 0.0f, max_radps_after = 0.0f;
+  float max_mps_before = 0.0f, max_mps_after = 0.0f;
+  int speed_clamps = 0;      // connected steps shortened to a limit
+  int workspace_clamps = 0;  // connected positions moved back into Ψ
+};
+
+// X5 on a dense trajectory (time_s from its first sample, in the time the host executes it):
+// from `from` at the first sample to the trajectory, by the minimal rotation in (yaw, pitch)
+// and a cubic blend in position. Over the stretch the difference between the pose and the
+// trajectory (taken where the hold ends) is faded out with the smoothstep 3x² − 2x³, so the
+// camera starts at the pose, leaves it at rest relative to the trajectory and joins the
+// trajectory with its own velocity; positions are then clamped into Ψ of their base poses, and
+// one forward pass keeps every step within the speed limits (Ψ wins over speed, as in
+// InterpolateCameraPath). A trajectory already starting at the pose is left as it is.
+CameraConnection ConnectCameraTrajectory(const CameraPose& from, const CameraConnectParams& params,
+                                         CameraTrajectory* trajectory);
 
 // Times of the samples from the path start: arc length / base speed.
 std::vector<double> CameraSampleTimes(std::span<const CameraBaseSample> path, float base_speed_mps);
@@ -219,9 +355,14 @@ CameraTrajectory InterpolateCameraPath(std::span<const CameraBaseSample> path,
                                        std::span<const CameraCandidate* const> views,
                                        const CameraInterpolationParams& params);
 
-// The whole of §5 in the given mode: candidates, selection and dense trajectory.
+// The whole of §5 in the given mode: candidates, selection and dense trajectory. With look-at
+// targets (X12, not in "fixed": a rigid mount has nothing to choose) the candidates get their U
+// and the look-at views before the selection.
 CameraPathResult PlanCameraPath(std::span<const CameraBaseSample> path,
                                 const CameraPathParams& params, const CameraFreeFn& free,
                                 const CameraScoreFn& score);
+CameraPathResult PlanCameraPath(std::span<const CameraBaseSample> path,
+                                const CameraPathParams& params, const CameraFreeFn& free,
+                                const CameraScoreFn& score, const CameraLookAt& lookat);
 
 }  // namespace voxplan::tensorfield
