@@ -127,9 +127,9 @@ voxplan_pkg_config(voxplan-core "voxel blocks, hash map, TSDF volume, queries, r
 voxplan_pkg_config(voxplan-fusion "TSDF integration, tracking, marching cubes"
   REQUIRES voxplan-core LIBS ${pc_libdir} -lvoxplan_fusion -lopencv_imgproc -lopencv_core)
 voxplan_pkg_config(voxplan-io "dataset readers, trajectories, images, mesh and map files"
-  REQUIRES voxplan-core libpng libjpeg zlib libdeflate assimp LIBS ${pc_libdir} -lvoxplan_io
-  -lrosbag_storage -lrostime -lroscpp_serialization -lcpp_common -lconsole_bridge -lroslz4 -lbz2
-  -lopencv_imgcodecs -lopencv_core)
+  REQUIRES voxplan-core libpng libjpeg zlib libdeflate assimp libtiff-4 OpenEXR
+  LIBS ${pc_libdir} -lvoxplan_io
+  -lrosbag_storage -lrostime -lroscpp_serialization -lcpp_common -lconsole_bridge -lroslz4 -lbz2)
 voxplan_pkg_config(voxplan-pipeline "whole fusion jobs over a dataset"
   REQUIRES voxplan-fusion voxplan-io LIBS ${pc_libdir} -lvoxplan_pipeline)
 set(pc_mpi "")
@@ -178,7 +178,7 @@ set(CPACK_DEBIAN_RUNTIME_PACKAGE_SHLIBDEPS ON)
 set(CPACK_DEBIAN_DEV_PACKAGE_NAME voxplan-dev)
 set(CPACK_DEBIAN_DEV_PACKAGE_SECTION libdevel)
 set(dev_depends libeigen3-dev libtbb-dev libpng-dev libjpeg62-turbo-dev libdeflate-dev
-  libassimp-dev nlohmann-json3-dev libopencv-imgproc-dev libopencv-imgcodecs-dev
+  libassimp-dev nlohmann-json3-dev libopencv-imgproc-dev libtiff-dev libopenexr-dev libimath-dev
   librosbag-storage-dev)
 if(VOXPLAN_HAVE_MPI)
   list(APPEND dev_depends libopenmpi-dev)

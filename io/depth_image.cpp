@@ -1,19 +1,22 @@
-// Depth images of every type (depth_image.h): PNG through image_io.h; TIFF and OpenEXR through
-// OpenCV's imgcodecs, the one file of voxplan that includes it. Their headers are parsed here
-// first (TIFF's first image directory; EXR's attributes and its chunk offset table), so that the
-// refusals name the file and say why, sizes are bounded before anything is decoded, and OpenCV
-// never sees a file it would misread: OpenCV 4.6 reads a lone EXR channel that is not named Y or
-// R as zeros, and prints (to std::cerr) the exception OpenEXR throws on a truncated file (or on
-// compressed data that does not decode, which only decoding finds).
-//
-// OPENCV_IO_ENABLE_OPENEXR: Debian 12's OpenCV 4.6 is built with OpenEXR reading on, so nothing
-// needs setting (setenv in a library would race with every getenv of the process). A user who
-// set it to 0 in the environment turned it off on purpose (opencv issue 21326: OpenEXR's security
-// record); the reader then refuses EXR files saying so, and leaves the environment alone.
+// Depth images of every type (depth_image.h): PNG through image_io.h; TIFF through libtiff and
+// OpenEXR through OpenEXR's C++ library, the one file of voxplan that includes either. Their
+// headers are parsed here first (TIFF's first image directory; EXR's attributes and its chunk
+// offset table), so that the refusals name the file and say why and sizes are bounded before
+// either library allocates or decodes anything; each decoder then checks that its library sees
+// the image the header stated. Nothing is printed: libtiff's messages go to handlers of each
+// call (TiffMessages), OpenEXR's to the exceptions caught here, both into the error returned.
 #include "io/depth_image.h"
 
+#include <ImfChannelList.h>
+#include <ImfFrameBuffer.h>
+#include <ImfHeader.h>
+#include <ImfInputFile.h>
+#include <tiffio.h>
+
+#include <algorithm>
 #include <cerrno>
 #include <cmath>
+#include <cstdarg>
 #include <cstdint>
 #include <cstdio>
 #include <cstdlib>
@@ -21,8 +24,7 @@
 #include <exception>
 #include <filesystem>
 #include <limits>
-#include <opencv2/core.hpp>
-#include <opencv2/imgcodecs.hpp>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -84,6 +86,20 @@ Status CheckSides(const std::string& path, const char* what, int64_t width, int6
   return Status::Ok();
 }
 
+// Tiles no larger than the image needs (a side up to twice the image's, or up to 1024), so that a
+// corrupt header cannot make the decoder allocate more than a few times the image.
+Status CheckTiles(const std::string& path, const char* what, uint64_t tile_w, uint64_t tile_h,
+                  uint64_t width, uint64_t height) {
+  const auto fits = [](uint64_t tile, uint64_t side) {
+    return tile >= 1 && tile <= std::max<uint64_t>(2 * side, 1024);
+  };
+  if (!fits(tile_w, width) || !fits(tile_h, height))
+    return CorruptData(path + ": " + what + " tiles of " + Text(tile_w) + "x" + Text(tile_h) +
+                       " pixels for a " + Text(width) + "x" + Text(height) + " image; a tile " +
+                       "side must be 1 to twice the image's side (or to 1024)");
+  return Status::Ok();
+}
+
 // ---------------------------------------------------------------------------------------------
 // TIFF: the byte order, the first image file directory and the tags that say what a pixel is.
 
@@ -135,11 +151,14 @@ Result<DepthFileHeader> ParseTiff(const std::string& path, const FileBytes& f) {
 
   // The first value of each tag read; absent ones take TIFF's defaults (no width or height).
   uint64_t width = 0, height = 0, bits = 1, samples = 1, format = 1, photometric = 1;
-  bool have_width = false, have_height = false;
+  uint64_t tile_w = 0, tile_h = 0;
+  bool have_width = false, have_height = false, tiled = false;
   for (uint64_t i = 0; i < n; ++i) {
     const uint8_t* entry = entries.data() + size_t(i) * entry_bytes;
     const uint64_t tag = e.Get(entry, 2), type = e.Get(entry + 2, 2);
-    if (tag != 256 && tag != 257 && tag != 258 && tag != 262 && tag != 277 && tag != 339) continue;
+    if (tag != 256 && tag != 257 && tag != 258 && tag != 262 && tag != 277 && tag != 322 &&
+        tag != 323 && tag != 339)
+      continue;
     const uint64_t count = e.Get(entry + 4, big ? 8 : 4);
     const uint8_t* value_field = entry + (big ? 12 : 8);
     // BYTE, SHORT, LONG, LONG8.
@@ -171,6 +190,12 @@ Result<DepthFileHeader> ParseTiff(const std::string& path, const FileBytes& f) {
       case 277:
         samples = value;
         break;
+      case 322:
+        tile_w = value, tiled = true;
+        break;
+      case 323:
+        tile_h = value, tiled = true;
+        break;
       default:  // 339
         format = value;
         break;
@@ -181,6 +206,7 @@ Result<DepthFileHeader> ParseTiff(const std::string& path, const FileBytes& f) {
                        (have_width ? "ImageLength" : "ImageWidth") + " tag");
   VOXPLAN_RETURN_IF_ERROR(CheckSides(path, "TIFF", int64_t(std::min<uint64_t>(width, 1u << 30)),
                                      int64_t(std::min<uint64_t>(height, 1u << 30))));
+  if (tiled) VOXPLAN_RETURN_IF_ERROR(CheckTiles(path, "TIFF", tile_w, tile_h, width, height));
   if (samples != 1)
     return Unsupported(path + ": depth TIFF must be single-channel, found " + Text(samples) +
                        " samples per pixel");
@@ -273,6 +299,8 @@ Result<DepthFileHeader> ParseExr(const std::string& path, const FileBytes& f) {
   bool have_channels = false, have_window = false, have_compression = false;
   int64_t x_min = 0, y_min = 0, x_max = -1, y_max = -1;
   int compression = 0;
+  bool have_tiles = false;
+  uint64_t tile_w = 0, tile_h = 0;
   size_t at = 8;
   for (;;) {
     if (at >= have)
@@ -315,6 +343,10 @@ Result<DepthFileHeader> ParseExr(const std::string& path, const FileBytes& f) {
     } else if (name == "compression" && type == "compression" && size == 1) {
       have_compression = true;
       compression = b[value];
+    } else if (name == "tiles" && type == "tiledesc" && size == 9) {
+      have_tiles = true;
+      tile_w = uint32_t(Int32(b.data() + value));
+      tile_h = uint32_t(Int32(b.data() + value + 4));
     }
   }
   if (!have_channels || !have_window || !have_compression)
@@ -331,11 +363,7 @@ Result<DepthFileHeader> ParseExr(const std::string& path, const FileBytes& f) {
     return Unsupported(path + ": depth EXR must have one channel, found " +
                        std::to_string(channels.size()) + (names.empty() ? "" : " (" + names + ")"));
   }
-  const ExrChannel& ch = channels.front();
-  if (ch.name != "Y" && ch.name != "R")
-    return Unsupported(path + ": depth EXR channel is named '" + ch.name +
-                       "'; OpenCV 4.6 reads a lone channel only when it is named Y (as OpenCV " +
-                       "writes it) or R, and would read this one as zeros: rename the channel");
+  const ExrChannel& ch = channels.front();  // any name: Y, R, Z, Depth.Z, ...
   if (ch.pixel_type != 1 && ch.pixel_type != 2)
     return Unsupported(path + ": depth EXR channel " + ch.name + " must hold float metres (32- " +
                        "or 16-bit), found " +
@@ -348,9 +376,13 @@ Result<DepthFileHeader> ParseExr(const std::string& path, const FileBytes& f) {
     return Unsupported(path + ": OpenEXR compression " + std::to_string(compression) +
                        " is unknown");
 
-  if (!tiled) {
-    // The offset table, then each chunk's y and size: all inside the file. Catches a truncated
-    // file here rather than in OpenEXR (whose exception OpenCV prints).
+  if (tiled) {
+    if (!have_tiles) return CorruptData(path + ": tiled OpenEXR header has no 'tiles' attribute");
+    VOXPLAN_RETURN_IF_ERROR(
+        CheckTiles(path, "OpenEXR", tile_w, tile_h, uint64_t(width), uint64_t(height)));
+  } else {
+    // The offset table, then each chunk's y and size: all inside the file, so that a truncated
+    // file is refused by its header, before OpenEXR reads a pixel.
     const uint64_t chunks = uint64_t((height + lines - 1) / lines);
     std::vector<uint8_t> table(size_t(chunks) * 8);
     if (!f.Read(at, table.data(), table.size()))
@@ -385,60 +417,158 @@ Result<DepthFileHeader> ParseHeader(const std::string& path, DepthFileType type,
 }
 
 // ---------------------------------------------------------------------------------------------
-// Decoding through OpenCV, its result checked against the header.
+// Decoding: TIFF through libtiff, EXR through OpenEXR, each checked against the parsed header.
 
-Result<DepthImage> DecodeWithOpenCv(const std::string& path, const DepthFileHeader& header,
-                                    double depth_scale) {
-  cv::Mat m;
-  try {
-    // By path: OpenCV's EXR decoder reads only files (imdecode would write a temporary one).
-    // IMREAD_UNCHANGED: the samples as stored, no orientation applied.
-    m = cv::imread(path, cv::IMREAD_UNCHANGED);
-  } catch (const cv::Exception& e) {
-    if (header.type == DepthFileType::kExr &&
-        e.err.find("OPENCV_IO_ENABLE_OPENEXR") != e.err.npos) {
-      const char* env = std::getenv("OPENCV_IO_ENABLE_OPENEXR");
-      return Unsupported(path +
-                         ": OpenCV's EXR reader is switched off by OPENCV_IO_ENABLE_OPENEXR=" +
-                         (env ? env : "") + " in the environment; unset it (Debian's OpenCV " +
-                         "reads EXR by default) or convert the depth to 32-bit float TIFF");
+// NaN fails the first test; +inf the second; negative (and -0) depth is no depth.
+void ZeroInvalid(DepthImage& metres) {
+  for (float& v : metres.data) v = v > 0.f && v <= std::numeric_limits<float>::max() ? v : 0.f;
+}
+
+// libtiff's errors and warnings for one TIFF handle, never printed. The handlers are given to
+// TIFFOpenExt with this call's own TiffMessages as their user data, and return 1 so that
+// libtiff's process-wide handlers (stderr by default) are not called: nothing is shared between
+// the threads that decode at once (Dataset::Load), and the process's handlers are left alone.
+struct TiffMessages {
+  std::string first_error;
+
+  static int OnError(TIFF*, void* user, const char* module, const char* fmt, va_list ap) {
+    auto* self = static_cast<TiffMessages*>(user);
+    if (self->first_error.empty()) {
+      char text[512];
+      std::vsnprintf(text, sizeof text, fmt, ap);
+      self->first_error = module && *module ? std::string(module) + ": " + text : text;
     }
-    return CorruptData(path + ": OpenCV cannot read it: " + e.err);
-  } catch (const std::exception& e) {
-    return CorruptData(path + ": OpenCV cannot read it: " + e.what());
+    return 1;
   }
-  const char* name = DepthFileTypeName(header.type);
-  if (m.empty())
-    return CorruptData(path + ": OpenCV could not decode this " + name +
-                       " file (corrupt or truncated pixel data)");
-  // A lone R channel comes back as BGR with blue and green zero.
-  const bool red = header.type == DepthFileType::kExr && m.type() == CV_32FC3;
-  const int expected = header.bits == 16 && !header.metres ? CV_16UC1 : CV_32FC1;
-  if ((m.type() != expected && !red) || m.cols != header.width || m.rows != header.height)
-    return CorruptData(path + ": OpenCV decoded a " + std::to_string(m.cols) + "x" +
-                       std::to_string(m.rows) + " image of type " + cv::typeToString(m.type()) +
-                       " but the header states " + std::to_string(header.width) + "x" +
-                       std::to_string(header.height) + " " + header.Encoding());
+  static int OnWarning(TIFF*, void*, const char*, const char*, va_list) { return 1; }
+  std::string Suffix() const {
+    return first_error.empty() ? "" : " (libtiff: " + first_error + ")";
+  }
+};
+
+struct TiffCloser {
+  void operator()(TIFF* tif) const { TIFFClose(tif); }
+};
+struct TiffOptionsFree {
+  void operator()(TIFFOpenOptions* options) const { TIFFOpenOptionsFree(options); }
+};
+
+Result<DepthImage> DecodeTiff(const std::string& path, const DepthFileHeader& header,
+                              double depth_scale) {
+  TiffMessages messages;
+  std::unique_ptr<TIFF, TiffCloser> tif;
+  {
+    std::unique_ptr<TIFFOpenOptions, TiffOptionsFree> options(TIFFOpenOptionsAlloc());
+    if (!options) return IoError(path + ": libtiff cannot allocate its open options");
+    TIFFOpenOptionsSetErrorHandlerExtR(options.get(), &TiffMessages::OnError, &messages);
+    TIFFOpenOptionsSetWarningHandlerExtR(options.get(), &TiffMessages::OnWarning, &messages);
+    // "m": read(), not mmap: a file truncated while it is read is an error, not SIGBUS. The
+    // handle keeps the handlers; the options may go.
+    tif.reset(TIFFOpenExt(path.c_str(), "rm", options.get()));
+  }
+  if (!tif) return CorruptData(path + ": libtiff cannot read this TIFF file" + messages.Suffix());
+  uint32_t width = 0, height = 0;
+  uint16_t bits = 0, samples = 0, format = 0;
+  if (!TIFFGetField(tif.get(), TIFFTAG_IMAGEWIDTH, &width) ||
+      !TIFFGetField(tif.get(), TIFFTAG_IMAGELENGTH, &height) ||
+      !TIFFGetFieldDefaulted(tif.get(), TIFFTAG_BITSPERSAMPLE, &bits) ||
+      !TIFFGetFieldDefaulted(tif.get(), TIFFTAG_SAMPLESPERPIXEL, &samples) ||
+      !TIFFGetFieldDefaulted(tif.get(), TIFFTAG_SAMPLEFORMAT, &format))
+    return CorruptData(path + ": libtiff finds no image size or sample layout" + messages.Suffix());
+  const uint16_t expected_format = header.metres ? SAMPLEFORMAT_IEEEFP : SAMPLEFORMAT_UINT;
+  if (int64_t(width) != header.width || int64_t(height) != header.height || bits != header.bits ||
+      samples != 1 || format != expected_format)
+    return CorruptData(path + ": libtiff reads a " + Text(width) + "x" + Text(height) +
+                       " image of " + Text(samples) + " " + Text(bits) + "-bit samples (format " +
+                       Text(format) + ") but the header states " + std::to_string(header.width) +
+                       "x" + std::to_string(header.height) + " " + header.Encoding());
+  // With one sample per pixel both planar configurations lay the samples out alike.
+  const size_t bytes = size_t(bits / 8), row_bytes = size_t(width) * bytes;
+  std::vector<uint16_t> units;
   DepthImage depth(header.width, header.height);
-  if (m.type() == CV_16UC1) {
+  uint8_t* out = reinterpret_cast<uint8_t*>(depth.data.data());
+  if (!header.metres) {
+    units.resize(size_t(width) * height);
+    out = reinterpret_cast<uint8_t*>(units.data());
+  }
+  if (TIFFIsTiled(tif.get())) {
+    uint32_t tile_w = 0, tile_h = 0;
+    if (!TIFFGetField(tif.get(), TIFFTAG_TILEWIDTH, &tile_w) ||
+        !TIFFGetField(tif.get(), TIFFTAG_TILELENGTH, &tile_h))
+      return CorruptData(path + ": tiled TIFF without its tile size" + messages.Suffix());
+    VOXPLAN_RETURN_IF_ERROR(CheckTiles(path, "TIFF", tile_w, tile_h, width, height));
+    const size_t tile_row_bytes = size_t(tile_w) * bytes;
+    std::vector<uint8_t> tile(tile_row_bytes * tile_h);
+    const uint32_t tiles = TIFFNumberOfTiles(tif.get());
+    for (uint32_t y = 0; y < height; y += tile_h) {
+      for (uint32_t x = 0; x < width; x += tile_w) {
+        const uint32_t k = TIFFComputeTile(tif.get(), x, y, 0, 0);
+        if (TIFFReadEncodedTile(tif.get(), k, tile.data(), tmsize_t(tile.size())) !=
+            tmsize_t(tile.size()))
+          return CorruptData(path + ": TIFF tile " + Text(k) + " of " + Text(tiles) +
+                             " does not decode (corrupt or truncated pixel data)" +
+                             messages.Suffix());
+        const uint32_t rows = std::min(tile_h, height - y), cols = std::min(tile_w, width - x);
+        for (uint32_t r = 0; r < rows; ++r)
+          std::memcpy(out + size_t(y + r) * row_bytes + size_t(x) * bytes,
+                      tile.data() + size_t(r) * tile_row_bytes, size_t(cols) * bytes);
+      }
+    }
+  } else {
+    uint32_t rows_per_strip = 0;
+    TIFFGetFieldDefaulted(tif.get(), TIFFTAG_ROWSPERSTRIP, &rows_per_strip);
+    if (rows_per_strip == 0 || rows_per_strip > height) rows_per_strip = height;
+    const uint32_t strips = TIFFNumberOfStrips(tif.get());
+    for (uint32_t y = 0; y < height; y += rows_per_strip) {
+      const uint32_t k = TIFFComputeStrip(tif.get(), y, 0);
+      const size_t size = size_t(std::min(rows_per_strip, height - y)) * row_bytes;
+      if (TIFFReadEncodedStrip(tif.get(), k, out + size_t(y) * row_bytes, tmsize_t(size)) !=
+          tmsize_t(size))
+        return CorruptData(path + ": TIFF strip " + Text(k) + " of " + Text(strips) +
+                           " does not decode (corrupt or truncated pixel data)" +
+                           messages.Suffix());
+    }
+  }
+  if (header.metres) {
+    ZeroInvalid(depth);
+  } else {
     const double inv_scale = 1.0 / depth_scale;  // as ReadDepthPng: the same floats
-    for (int y = 0; y < m.rows; ++y) {
-      const uint16_t* row = m.ptr<uint16_t>(y);
-      float* out = depth.data.data() + size_t(y) * size_t(header.width);
-      for (int x = 0; x < m.cols; ++x) out[x] = float(double(row[x]) * inv_scale);
-    }
-    return depth;
+    for (size_t i = 0; i < units.size(); ++i) depth.data[i] = float(double(units[i]) * inv_scale);
   }
-  const int step = red ? 3 : 1, channel = red ? 2 : 0;
-  for (int y = 0; y < m.rows; ++y) {
-    const float* row = m.ptr<float>(y);
-    float* out = depth.data.data() + size_t(y) * size_t(header.width);
-    for (int x = 0; x < m.cols; ++x) {
-      const float v = row[x * step + channel];
-      // NaN fails the first test; +inf the second; negative (and -0) depth is no depth.
-      out[x] = v > 0.f && v <= std::numeric_limits<float>::max() ? v : 0.f;
-    }
+  return depth;
+}
+
+// The one channel as 32-bit floats, whatever its name (the header parser allows one channel of
+// HALF or FLOAT; OpenEXR widens HALF exactly). OpenEXR reports every failure by an exception;
+// it prints nothing.
+Result<DepthImage> DecodeExr(const std::string& path, const DepthFileHeader& header) {
+  DepthImage depth(header.width, header.height);
+  try {
+    // Threads: OpenEXR's global count, 0 unless the process set it: decoded on this thread.
+    Imf::InputFile file(path.c_str());
+    const Imath::Box2i window = file.header().dataWindow();
+    const Imf::ChannelList& channels = file.header().channels();
+    auto channel = channels.begin();
+    size_t count = 0;
+    for (auto c = channels.begin(); c != channels.end(); ++c) ++count;
+    if (int64_t(window.max.x) - window.min.x + 1 != header.width ||
+        int64_t(window.max.y) - window.min.y + 1 != header.height || count != 1)
+      return CorruptData(path + ": OpenEXR reads another image than its header states (" +
+                         std::to_string(header.width) + "x" + std::to_string(header.height) +
+                         ", one channel)");
+    Imf::FrameBuffer frame;
+    frame.insert(channel.name(),
+                 Imf::Slice::Make(Imf::FLOAT, depth.data.data(), window, sizeof(float),
+                                  sizeof(float) * size_t(header.width)));
+    file.setFrameBuffer(frame);
+    file.readPixels(window.min.y, window.max.y);
+  } catch (const std::exception& e) {
+    return CorruptData(path +
+                       ": OpenEXR cannot decode it (corrupt or truncated pixel data): " + e.what());
+  } catch (...) {
+    return CorruptData(path + ": OpenEXR cannot decode it (corrupt or truncated pixel data)");
   }
+  ZeroInvalid(depth);
   return depth;
 }
 
@@ -511,7 +641,8 @@ Result<DepthImage> ReadDepthImage(const std::string& path, double depth_scale,
   if (!header.ok()) return header.status();
   if (!header->metres) VOXPLAN_RETURN_IF_ERROR(CheckScale(path, depth_scale));
   if (header_out) *header_out = *header;
-  return DecodeWithOpenCv(path, *header, depth_scale);
+  return type == DepthFileType::kTiff ? DecodeTiff(path, *header, depth_scale)
+                                      : DecodeExr(path, *header);
 }
 
 }  // namespace voxplan

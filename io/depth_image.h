@@ -1,12 +1,12 @@
 #pragma once
-// Depth images in every file type the dataset readers take: 16-bit PNG (image_io.h), and through
-// OpenCV's imgcodecs TIFF (.tif, .tiff: 16-bit unsigned or 32-bit float samples) and OpenEXR
-// (.exr: one 32-bit or 16-bit float channel). The type comes from the file name's extension;
-// 16-bit integer files hold units of 1 / depth_scale metres, float files hold metres (the depth
-// scale does not apply). Headers are read and checked by voxplan before OpenCV sees the file, so
-// that a wrong kind of file is refused with a message naming it and a corrupt one is caught
-// before it is decoded. Every error names the file; nothing is printed, except the line OpenCV
-// 4.6 prints itself for an EXR whose compressed pixel data does not decode (io/README.md).
+// Depth images in every file type the dataset readers take: 16-bit PNG (image_io.h), TIFF (.tif,
+// .tiff: 16-bit unsigned or 32-bit float samples, in strips or tiles) through libtiff, and OpenEXR
+// (.exr: one 32-bit or 16-bit float channel, of any name, scanline or tiled) through OpenEXR. The
+// type comes from the file name's extension; 16-bit integer files hold units of 1 / depth_scale
+// metres, float files hold metres (the depth scale does not apply). Headers are read and checked
+// by voxplan before either library sees the file, so that a wrong kind of file is refused with a
+// message naming it and a corrupt one is caught before it is decoded. Every error names the file;
+// nothing is printed (libtiff's messages are caught per call, OpenEXR's exceptions too).
 #include <string>
 
 #include "core/image.h"
@@ -32,9 +32,9 @@ struct DepthFileHeader {
 };
 
 // Reads and checks the header: refuses every file ReadDepthImage would refuse for its kind
-// (Unsupported: multi-channel, 8-bit, signed or 64-bit samples, other EXR channel names or
-// types) or its header (CorruptData: not the format its name says, sizes beyond 16384 per
-// side, directories or chunks outside the file).
+// (Unsupported: multi-channel, 8-bit, signed or 64-bit samples, EXR channel types other than
+// float) or its header (CorruptData: not the format its name says, sizes beyond 16384 per side,
+// tiles far larger than the image, directories or chunks outside the file).
 Result<DepthFileHeader> ReadDepthHeader(const std::string& path);
 
 // Decodes a depth image into metres (0 = invalid). 16-bit samples: value / depth_scale, as

@@ -1,9 +1,11 @@
 // Float depth (io/depth_image.h): 32-bit float TIFF and OpenEXR in metres, 16-bit TIFF in
-// units, written by OpenCV here; read back exactly (both are lossless), invalid values to 0,
-// every other kind of file refused naming it, nothing printed; and the dataset readers that list
-// depth files (TUM-style lists, 7-Scenes frame folders, Redwood depth/) reading them as metres.
+// units, written by libtiff and OpenEXR here in the layouts tools write; read back exactly (all
+// lossless), invalid values to 0, every other kind of file refused naming it, nothing printed,
+// from several threads at once too; and the dataset readers that list depth files (TUM-style
+// lists, 7-Scenes frame folders, Redwood depth/) reading them as metres.
 #include <gtest/gtest.h>
 
+#include <atomic>
 #include <cmath>
 #include <cstring>
 #include <filesystem>
@@ -11,6 +13,7 @@
 #include <iterator>
 #include <limits>
 #include <string>
+#include <thread>
 #include <vector>
 
 #include "io/dataset.h"
@@ -135,41 +138,98 @@ TEST(DepthImage, FloatTiffAndExrReadBackExactlyInMetres) {
   }
 }
 
-TEST(DepthImage, ExrHalfFloatAndALoneRedChannel) {
+std::vector<float> Plane(const DepthImage& d) { return {d.data.begin(), d.data.end()}; }
+
+TEST(DepthImage, EveryLosslessLayoutReadsTheSameMetres) {
+  test::TempDir dir("depth_image");
+  const DepthImage depth = WithInvalidValues(37, 23);  // no side a multiple of a tile's
+  struct TiffCase {
+    const char* name;
+    test::TiffLayout layout;
+  };
+  std::vector<TiffCase> tiffs = {
+      {"none.tif", {COMPRESSION_NONE}},
+      {"lzw_rows1.tif", {COMPRESSION_LZW, PREDICTOR_NONE, 0, 1}},
+      {"deflate_fp.tif", {COMPRESSION_ADOBE_DEFLATE, PREDICTOR_FLOATINGPOINT}},
+      {"packbits.tif", {COMPRESSION_PACKBITS}},
+      {"zstd.tif", {COMPRESSION_ZSTD}},
+      {"big_endian.tif", {COMPRESSION_NONE, PREDICTOR_NONE, 0, 5, true}},
+      // (Not big-endian with the floating-point predictor: Debian 12's libtiff 4.5.0 writes its
+      // bytes wrong, as an independent decoder shows.)
+      {"big_endian_lzw.tif", {COMPRESSION_LZW, PREDICTOR_NONE, 0, 0, true}},
+      {"tiles16.tif", {COMPRESSION_NONE, PREDICTOR_NONE, 16}},
+      {"tiles32_deflate.tif", {COMPRESSION_ADOBE_DEFLATE, PREDICTOR_FLOATINGPOINT, 32}},
+      {"tiles_big_endian.tif", {COMPRESSION_LZW, PREDICTOR_NONE, 16, 0, true}},
+      {"directory_first.tif",
+       {COMPRESSION_LZW, PREDICTOR_NONE, 0, 4, false, PLANARCONFIG_CONTIG, true}},
+      // One sample per pixel: the separate planar configuration is the same layout.
+      {"planar_separate.tif",
+       {COMPRESSION_NONE, PREDICTOR_NONE, 0, 0, false, PLANARCONFIG_SEPARATE}},
+  };
+  for (const TiffCase& c : tiffs) {
+    SCOPED_TRACE(c.name);
+    test::WriteTiff(dir / c.name, 37, 23, 1, 32, SAMPLEFORMAT_IEEEFP, depth.data.data(), c.layout);
+    auto read = ReadQuietly(dir / c.name);
+    ASSERT_TRUE(read.ok()) << read.message();
+    ExpectSameMetres(*ReadDepthImage((dir / c.name).string(), 1000.0), depth);
+  }
+  struct ExrCase {
+    const char* name;
+    test::ExrLayout layout;
+  };
+  const std::vector<ExrCase> exrs = {
+      {"none.exr", {Imf::NO_COMPRESSION}},
+      {"rle.exr", {Imf::RLE_COMPRESSION}},
+      {"zips.exr", {Imf::ZIPS_COMPRESSION}},
+      {"zip.exr", {Imf::ZIP_COMPRESSION}},
+      {"piz.exr", {Imf::PIZ_COMPRESSION}},
+      {"origin.exr", {Imf::ZIP_COMPRESSION, 0, -3, 12}},  // the data window need not start at 0
+      {"tiles16.exr", {Imf::NO_COMPRESSION, 16}},
+      {"tiles32_zip.exr", {Imf::ZIP_COMPRESSION, 32}},
+      {"tiles_piz_origin.exr", {Imf::PIZ_COMPRESSION, 16, 5, -7}},
+  };
+  for (const ExrCase& c : exrs) {
+    SCOPED_TRACE(c.name);
+    test::WriteExr(dir / c.name, 37, 23, {"Y"}, {Plane(depth)}, Imf::FLOAT, c.layout);
+    auto header = ReadDepthHeader((dir / c.name).string());
+    ASSERT_TRUE(header.ok()) << header.status().message();
+    EXPECT_EQ(header->width, 37);
+    EXPECT_EQ(header->height, 23);
+    auto read = ReadQuietly(dir / c.name);
+    ASSERT_TRUE(read.ok()) << read.message();
+    ExpectSameMetres(*ReadDepthImage((dir / c.name).string(), 1000.0), depth);
+  }
+}
+
+TEST(DepthImage, ExrHalfFloatAndAnyChannelName) {
   test::TempDir dir("depth_image");
   const DepthImage depth = Ramp(16, 9);
-  // Half floats: metres rounded to 11 bits, read as OpenCV widens them (exactly).
-  const fs::path half = dir / "half.exr";
-  test::WriteWithOpenCv(half, test::ToMat(depth),
-                        {cv::IMWRITE_EXR_TYPE, cv::IMWRITE_EXR_TYPE_HALF});
-  auto h = ReadDepthImage(half.string(), 1000.0);
-  ASSERT_TRUE(h.ok()) << h.status().message();
-  EXPECT_EQ(ReadDepthHeader(half.string())->Encoding(), "16-bit float EXR");
-  const cv::Mat widened = cv::imread(half.string(), cv::IMREAD_UNCHANGED);
-  for (size_t i = 5; i < depth.data.size(); ++i) {
-    EXPECT_EQ(h->data[i], widened.at<float>(int(i) / 16, int(i) % 16)) << i;
-    EXPECT_NEAR(h->data[i], depth.data[i], depth.data[i] * 1e-3f) << i;
+  // Half floats: metres rounded to 11 bits, read back widened exactly.
+  for (int tile : {0, 16}) {
+    SCOPED_TRACE(tile);
+    const fs::path half_exr = dir / ("half" + std::to_string(tile) + ".exr");
+    test::WriteExr(half_exr, 16, 9, {"Y"}, {Plane(depth)}, Imf::HALF, {Imf::ZIP_COMPRESSION, tile});
+    auto h = ReadDepthImage(half_exr.string(), 1000.0);
+    ASSERT_TRUE(h.ok()) << h.status().message();
+    EXPECT_EQ(ReadDepthHeader(half_exr.string())->Encoding(), "16-bit float EXR");
+    for (size_t i = 0; i < depth.data.size(); ++i) {
+      const float widened = float(half(depth.data[i]));
+      EXPECT_EQ(h->data[i], widened > 0.f && std::isfinite(widened) ? widened : 0.f) << i;
+      if (i >= 5) {
+        EXPECT_NEAR(h->data[i], depth.data[i], depth.data[i] * 1e-3f) << i;
+      }
+    }
   }
-  // OpenCV writes its one channel as Y; an uncompressed file renamed to R (as other tools
-  // write a lone channel) reads the same; a lone Z (which OpenCV 4.6 reads as zeros) and
-  // anything else is refused naming the channel.
-  const fs::path plain = dir / "plain.exr";
-  test::WriteWithOpenCv(plain, test::ToMat(depth),
-                        {cv::IMWRITE_EXR_COMPRESSION, cv::IMWRITE_EXR_COMPRESSION_NO});
-  std::string bytes = ReadBytes(plain);
-  const size_t chlist = bytes.find(std::string("channels\0chlist\0", 16));
-  ASSERT_NE(chlist, std::string::npos);
-  const size_t name = chlist + 16 + 4;
-  ASSERT_EQ(bytes.substr(name, 2), std::string("Y\0", 2));
-  bytes[name] = 'R';
-  WriteBytes(dir / "red.exr", bytes);
-  auto red = ReadDepthImage((dir / "red.exr").string(), 1000.0);
-  ASSERT_TRUE(red.ok()) << red.status().message();
-  ExpectSameMetres(*red, depth);
-  bytes[name] = 'Z';
-  WriteBytes(dir / "z.exr", bytes);
-  ExpectRefused(ReadQuietly(dir / "z.exr"), StatusCode::kUnsupported, dir / "z.exr",
-                "channel is named 'Z'");
+  // A lone channel reads the same whatever it is named: Y (as OpenCV writes it), R, Z (a
+  // common name for depth), a layer's Depth.Z.
+  for (const char* name : {"Y", "R", "Z", "ViewLayer.Depth.Z"}) {
+    SCOPED_TRACE(name);
+    const fs::path path = dir / (std::string("channel_") + name + ".exr");
+    test::WriteExr(path, 16, 9, {name}, {Plane(depth)}, Imf::FLOAT, {Imf::NO_COMPRESSION});
+    auto read = ReadQuietly(path);
+    ASSERT_TRUE(read.ok()) << read.message();
+    ExpectSameMetres(*ReadDepthImage(path.string(), 1000.0), depth);
+  }
 }
 
 TEST(DepthImage, SixteenBitTiffUsesTheDepthScaleLikeAPng) {
@@ -194,40 +254,71 @@ TEST(DepthImage, SixteenBitTiffUsesTheDepthScaleLikeAPng) {
   }
   ExpectRefused(ReadDepthImage(tif.string(), 0.0).status(), StatusCode::kInvalidArgument, tif,
                 "depth scale must be positive");
+  // Other layouts: the same floats as the PNG.
+  const test::TiffLayout layouts[] = {
+      {COMPRESSION_NONE, PREDICTOR_NONE, 0, 0, true},  // big-endian samples
+      {COMPRESSION_ADOBE_DEFLATE, PREDICTOR_HORIZONTAL},
+      {COMPRESSION_LZW, PREDICTOR_HORIZONTAL, 16, 0, true},  // tiles, big-endian
+      {COMPRESSION_NONE, PREDICTOR_NONE, 0, 2, false, PLANARCONFIG_CONTIG, true},
+  };
+  auto from_png = ReadDepthPng(png.string(), 5000.0);
+  ASSERT_TRUE(from_png.ok()) << from_png.status().message();
+  for (size_t k = 0; k < std::size(layouts); ++k) {
+    SCOPED_TRACE(k);
+    const fs::path other = dir / ("layout" + std::to_string(k) + ".tif");
+    test::WriteDepthTiff16(other, 11, 7, units, layouts[k]);
+    auto from_tif = ReadDepthImage(other.string(), 5000.0);
+    ASSERT_TRUE(from_tif.ok()) << from_tif.status().message();
+    EXPECT_EQ(from_tif->data, from_png->data);
+  }
 }
 
 TEST(DepthImage, RefusesOtherKindsNamingTheFile) {
   test::TempDir dir("depth_image");
-  const cv::Mat gray8(6, 5, CV_8UC1, cv::Scalar(7));
-  const cv::Mat rgb16(6, 5, CV_16UC3, cv::Scalar(1, 2, 3));
-  const cv::Mat rgbf(6, 5, CV_32FC3, cv::Scalar(1, 2, 3));
-  const cv::Mat doubles(6, 5, CV_64FC1, cv::Scalar(1.5));
-  const cv::Mat ints(6, 5, CV_32SC1, cv::Scalar(1500));
-  const cv::Mat signed16(6, 5, CV_16SC1, cv::Scalar(1500));
+  const std::vector<uint8_t> zeros(6 * 5 * 3 * 8, 0);  // enough for any of these
   struct Case {
     const char* name;
-    const cv::Mat* m;
+    int samples, bits;
+    uint16_t format;
     const char* why;
   } cases[] = {
-      {"gray8.tif", &gray8, "found 8-bit unsigned integer samples"},
-      {"rgb16.tif", &rgb16, "single-channel, found 3 samples per pixel"},
-      {"rgbf.tiff", &rgbf, "single-channel, found 3 samples per pixel"},
-      {"doubles.tif", &doubles, "found 64-bit float samples"},
-      {"ints.tif", &ints, "found 32-bit signed integer samples"},
-      {"signed16.tif", &signed16, "found 16-bit signed integer samples"},
-      {"rgbf.exr", &rgbf, "must have one channel, found 3 (B G R)"},
+      {"gray8.tif", 1, 8, SAMPLEFORMAT_UINT, "found 8-bit unsigned integer samples"},
+      {"rgb16.tif", 3, 16, SAMPLEFORMAT_UINT, "single-channel, found 3 samples per pixel"},
+      {"rgbf.tiff", 3, 32, SAMPLEFORMAT_IEEEFP, "single-channel, found 3 samples per pixel"},
+      {"doubles.tif", 1, 64, SAMPLEFORMAT_IEEEFP, "found 64-bit float samples"},
+      {"ints.tif", 1, 32, SAMPLEFORMAT_INT, "found 32-bit signed integer samples"},
+      {"uints.tif", 1, 32, SAMPLEFORMAT_UINT, "found 32-bit unsigned integer samples"},
+      {"signed16.tif", 1, 16, SAMPLEFORMAT_INT, "found 16-bit signed integer samples"},
   };
   for (const Case& c : cases) {
     SCOPED_TRACE(c.name);
-    test::WriteWithOpenCv(dir / c.name, *c.m);
+    test::WriteTiff(dir / c.name, 5, 6, c.samples, c.bits, c.format, zeros.data());
     ExpectRefused(ReadQuietly(dir / c.name), StatusCode::kUnsupported, dir / c.name, c.why);
   }
+  const std::vector<float> plane(5 * 6, 1.5f);
+  test::WriteExr(dir / "rgbf.exr", 5, 6, {"B", "G", "R"}, {plane, plane, plane});
+  ExpectRefused(ReadQuietly(dir / "rgbf.exr"), StatusCode::kUnsupported, dir / "rgbf.exr",
+                "must have one channel, found 3 (B G R)");
+  test::WriteExr(dir / "uint.exr", 5, 6, {"Z"}, {plane}, Imf::UINT);
+  ExpectRefused(ReadQuietly(dir / "uint.exr"), StatusCode::kUnsupported, dir / "uint.exr",
+                "channel Z must hold float metres (32- or 16-bit), found 32-bit unsigned integers");
+  // Tiles far larger than the image (a corrupt or hostile header): refused before allocating.
+  std::vector<float> small(16 * 16, 1.f);
+  test::WriteTiff(dir / "huge_tiles.tif", 16, 16, 1, 32, SAMPLEFORMAT_IEEEFP, small.data(),
+                  {COMPRESSION_LZW, PREDICTOR_NONE, 2048});
+  ExpectRefused(ReadQuietly(dir / "huge_tiles.tif"), StatusCode::kCorruptData,
+                dir / "huge_tiles.tif", "TIFF tiles of 2048x2048 pixels for a 16x16 image");
+  test::WriteExr(dir / "huge_tiles.exr", 16, 16, {"Y"}, {small}, Imf::FLOAT,
+                 {Imf::ZIP_COMPRESSION, 2048});
+  ExpectRefused(ReadQuietly(dir / "huge_tiles.exr"), StatusCode::kCorruptData,
+                dir / "huge_tiles.exr", "OpenEXR tiles of 2048x2048 pixels for a 16x16 image");
   // Not what its name says: a PNG named .tif, a TIFF named .exr, text, an empty file.
   const fs::path png = dir / "really_png.tif";
   const uint16_t units[4] = {1, 2, 3, 4};
   ASSERT_TRUE(WritePngRaw(png.string(), 2, 2, 1, 16, units).ok());
   ExpectRefused(ReadQuietly(png), StatusCode::kCorruptData, png, "not a TIFF file");
   test::WriteFloatDepth(dir / "t.tif", Ramp(4, 3));
+  ASSERT_TRUE(ReadDepthImage((dir / "t.tif").string(), 1000.0).ok());
   WriteBytes(dir / "tiff.exr", ReadBytes(dir / "t.tif"));
   ExpectRefused(ReadQuietly(dir / "tiff.exr"), StatusCode::kCorruptData, dir / "tiff.exr",
                 "not an OpenEXR file");
@@ -241,37 +332,83 @@ TEST(DepthImage, RefusesOtherKindsNamingTheFile) {
                 StatusCode::kNotFound, dir / "missing.exr", "not found");
 }
 
+// Strip (or tile) k's offset in a TIFF, as libtiff reads it.
+uint64_t StripOffset(const fs::path& path, uint32_t k = 0) {
+  TIFF* tif = TIFFOpen(path.c_str(), "r");
+  EXPECT_NE(tif, nullptr) << path;
+  if (!tif) return 0;
+  const uint64_t offset = TIFFGetStrileOffset(tif, k);
+  TIFFClose(tif);
+  return offset;
+}
+
+// `path` with strip k's zlib header garbled (a deflate TIFF), as `out`.
+void BreakZlibStrip(const fs::path& path, uint32_t k, const fs::path& out) {
+  std::string bytes = ReadBytes(path);
+  const uint64_t at = StripOffset(path, k);
+  ASSERT_LT(at + 2, bytes.size());
+  bytes[at] ^= 0x5a, bytes[at + 1] ^= 0x5a;
+  WriteBytes(out, bytes);
+}
+
 TEST(DepthImage, TruncatedAndCorruptFilesAreRefusedQuietly) {
   test::TempDir dir("depth_image");
   const DepthImage depth = Ramp(64, 40);
-  for (const char* name : {"d.tif", "d.exr"}) {
+  // TIFF with its directory first (so that cutting it cuts pixels), uncompressed and LZW; as
+  // libtiff writes it (directory last); EXR (whose header's chunk table shows the cut).
+  test::WriteTiff(dir / "first.tif", 64, 40, 1, 32, SAMPLEFORMAT_IEEEFP, depth.data.data(),
+                  {COMPRESSION_NONE, PREDICTOR_NONE, 0, 8, false, PLANARCONFIG_CONTIG, true});
+  test::WriteTiff(dir / "first_lzw.tif", 64, 40, 1, 32, SAMPLEFORMAT_IEEEFP, depth.data.data(),
+                  {COMPRESSION_LZW, PREDICTOR_NONE, 0, 8, false, PLANARCONFIG_CONTIG, true});
+  test::WriteTiff(dir / "first_tiles.tif", 64, 40, 1, 32, SAMPLEFORMAT_IEEEFP, depth.data.data(),
+                  {COMPRESSION_NONE, PREDICTOR_NONE, 16, 0, false, PLANARCONFIG_CONTIG, true});
+  test::WriteFloatDepth(dir / "d.tif", depth);
+  test::WriteFloatDepth(dir / "d.exr", depth);
+  ASSERT_LT(StripOffset(dir / "first.tif"), 1000u);  // the directory came first
+  for (const char* name : {"first.tif", "first_lzw.tif", "first_tiles.tif", "d.tif", "d.exr"}) {
     SCOPED_TRACE(name);
-    test::WriteFloatDepth(dir / name, depth);
     const std::string bytes = ReadBytes(dir / name);
+    ASSERT_TRUE(ReadQuietly(dir / name).ok());
     for (size_t keep : {size_t(6), size_t(40), bytes.size() / 3, bytes.size() - 9}) {
       const fs::path cut = dir / ("cut_" + std::to_string(keep) + "_" + name);
       WriteBytes(cut, bytes.substr(0, keep));
-      // EXR: the header's chunk table already shows the file is cut short (so OpenEXR never
-      // throws, and OpenCV never prints); TIFF: its strips are found short when decoded.
+      // EXR: the header's chunk table already shows the file is cut short; TIFF: a directory
+      // cut is refused by the header, pixels cut when libtiff decodes them.
       const Status s = ReadQuietly(cut, Contains(name, "exr"));
       ASSERT_FALSE(s.ok()) << cut << " (" << keep << " of " << bytes.size() << " bytes) read";
       EXPECT_EQ(s.code(), StatusCode::kCorruptData) << s.message();
       EXPECT_TRUE(Contains(s.message(), cut.string())) << s.message();
+      if (Contains(name, "first") && keep > 1000) {
+        EXPECT_TRUE(Contains(s.message(), "does not decode (corrupt or truncated pixel data)"))
+            << s.message();
+      }
     }
   }
-  // Compressed EXR data that does not decode: all chunks in the file, so only OpenCV finds it
-  // (and prints a line of its own, io/README.md); refused naming the file.
+  // Compressed pixels that do not decode, every chunk or strip in the file: only decoding finds
+  // them, refused naming the file with the library's reason, and nothing printed.
   DepthImage smooth(64, 64);
   for (size_t i = 0; i < smooth.data.size(); ++i) smooth.data[i] = 1.f + 0.001f * float(i % 64 / 8);
-  test::WriteFloatDepth(dir / "smooth.exr", smooth);
-  std::string zipped = ReadBytes(dir / "smooth.exr");
-  for (size_t i = zipped.size() * 2 / 3; i < zipped.size() * 2 / 3 + 20; ++i) zipped[i] ^= 0x5a;
-  WriteBytes(dir / "garbled.exr", zipped);
-  ASSERT_TRUE(ReadDepthHeader((dir / "garbled.exr").string()).ok());
-  testing::internal::CaptureStderr();
-  ExpectRefused(ReadDepthImage((dir / "garbled.exr").string(), 1000.0).status(),
-                StatusCode::kCorruptData, dir / "garbled.exr", "OpenCV could not decode");
-  testing::internal::GetCapturedStderr();
+  for (int tile : {0, 16}) {
+    SCOPED_TRACE(tile);
+    const fs::path zip = dir / ("smooth" + std::to_string(tile) + ".exr");
+    test::WriteExr(zip, 64, 64, {"Y"}, {Plane(smooth)}, Imf::FLOAT, {Imf::ZIP_COMPRESSION, tile});
+    std::string zipped = ReadBytes(zip);
+    for (size_t i = zipped.size() * 2 / 3; i < zipped.size() * 2 / 3 + 20; ++i) zipped[i] ^= 0x5a;
+    const fs::path garbled = dir / ("garbled" + std::to_string(tile) + ".exr");
+    WriteBytes(garbled, zipped);
+    ASSERT_TRUE(ReadDepthHeader(garbled.string()).ok());
+    ExpectRefused(ReadQuietly(garbled, false), StatusCode::kCorruptData, garbled,
+                  "OpenEXR cannot decode it (corrupt or truncated pixel data)");
+  }
+  // A deflate strip whose zlib header is wrong.
+  test::WriteTiff(dir / "deflate.tif", 64, 64, 1, 32, SAMPLEFORMAT_IEEEFP, smooth.data.data(),
+                  {COMPRESSION_ADOBE_DEFLATE});
+  BreakZlibStrip(dir / "deflate.tif", 0, dir / "bad_zlib.tif");
+  ExpectRefused(ReadQuietly(dir / "bad_zlib.tif", false), StatusCode::kCorruptData,
+                dir / "bad_zlib.tif", "TIFF strip 0 of ");
+  const std::string message =
+      ReadDepthImage((dir / "bad_zlib.tif").string(), 1000.0).status().message();
+  EXPECT_TRUE(Contains(message, "(libtiff: ")) << message;  // libtiff's reason, not printed
   // Headers claiming more than 16384 pixels a side are refused before anything is decoded.
   std::string exr = ReadBytes(dir / "d.exr");
   const size_t window = exr.find(std::string("dataWindow\0box2i\0", 17));
@@ -281,6 +418,53 @@ TEST(DepthImage, TruncatedAndCorruptFilesAreRefusedQuietly) {
   WriteBytes(dir / "huge.exr", exr);
   ExpectRefused(ReadQuietly(dir / "huge.exr"), StatusCode::kCorruptData, dir / "huge.exr",
                 "each side must be 1 to 16384 pixels");
+}
+
+// Datasets decode frames on several threads at once (Dataset::Load): every thread's errors are
+// its own (each names its file and its strip), the good files read right, nothing is printed.
+TEST(DepthImage, ThreadsDecodeAndRefuseQuietly) {
+  test::TempDir dir("depth_image_threads");
+  const DepthImage depth = Ramp(32, 48);
+  constexpr uint32_t kFiles = 8;  // strips of 4 rows: 12 strips
+  std::vector<fs::path> good, bad;
+  for (uint32_t k = 0; k < kFiles; ++k) {
+    const fs::path tif = dir / ("good" + std::to_string(k) + ".tif");
+    test::WriteTiff(tif, 32, 48, 1, 32, SAMPLEFORMAT_IEEEFP, depth.data.data(),
+                    {COMPRESSION_ADOBE_DEFLATE, PREDICTOR_NONE, 0, 4});
+    good.push_back(tif);
+    good.push_back(dir / ("good" + std::to_string(k) + ".exr"));
+    test::WriteFloatDepth(good.back(), depth);
+    bad.push_back(dir / ("bad" + std::to_string(k) + ".tif"));
+    BreakZlibStrip(tif, k, bad.back());
+  }
+  std::vector<std::string> failures[4];
+  testing::internal::CaptureStderr();
+  {
+    std::vector<std::thread> threads;
+    for (int t = 0; t < 4; ++t)
+      threads.emplace_back([&, t] {
+        for (int round = 0; round < 10; ++round)
+          for (uint32_t i = 0; i < kFiles; ++i) {
+            const uint32_t k = (i + uint32_t(t) * 3) % kFiles;
+            const Status s = ReadDepthImage(bad[k].string(), 1000.0).status();
+            const std::string expected =
+                bad[k].string() + ": TIFF strip " + std::to_string(k) + " of 12 does not decode";
+            if (s.ok() || s.message().rfind(expected, 0) != 0 ||
+                !Contains(s.message(), "(libtiff: "))
+              failures[t].push_back(bad[k].string() + " -> " + s.message());
+            for (const fs::path& g : {good[2 * k], good[2 * k + 1]}) {
+              auto read = ReadDepthImage(g.string(), 1000.0);
+              if (!read.ok() || read->data != depth.data)
+                failures[t].push_back(g.string() + " misread: " + read.status().message());
+            }
+          }
+      });
+    for (std::thread& thread : threads) thread.join();
+  }
+  EXPECT_EQ(testing::internal::GetCapturedStderr(), "");
+  for (const auto& f : failures) {
+    EXPECT_TRUE(f.empty()) << f.size() << " failures, the first: " << f.front();
+  }
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -363,7 +547,8 @@ TEST(DepthImageDatasets, SequencesDoNotMixUnitsOrSizes) {
   ExpectRefused(OpenDataset(root.string()).status(), StatusCode::kUnsupported, root / "depth/2.png",
                 "PNG depth in a sequence of TIFF depth images");
   // The first file's kind is checked when the dataset is opened.
-  test::WriteWithOpenCv(root / "depth/0.tif", cv::Mat(24, 32, CV_8UC1, cv::Scalar(3)));
+  const std::vector<uint8_t> gray8(32 * 24, 3);
+  test::WriteTiff(root / "depth/0.tif", 32, 24, 1, 8, SAMPLEFORMAT_UINT, gray8.data());
   WriteText(root / "depth.txt", "1.0 depth/0.tif\n");
   ExpectRefused(OpenDataset(root.string()).status(), StatusCode::kUnsupported, root / "depth/0.tif",
                 "8-bit unsigned integer");

@@ -246,13 +246,6 @@ TEST(FormatsCli, FloatDepthFusesLikeSixteenBitPng) {
     EXPECT_FALSE(stats.at("depth_scale_applies").get<bool>());
     EXPECT_EQ(stats.at("frames").get<int>(), 3);
   }
-  // A user who switched OpenCV's EXR reader off is told so, naming the file.
-  const RunResult off =
-      RunCli({"fuse", (dir / "float.exr").string(), "--stats", (dir / "off.json").string()},
-             "OPENCV_IO_ENABLE_OPENEXR=0");
-  EXPECT_EQ(off.exit_code, 1) << Describe(off);
-  EXPECT_NE(off.err.find("OPENCV_IO_ENABLE_OPENEXR=0"), std::string::npos) << Describe(off);
-  EXPECT_NE(off.err.find("0.exr"), std::string::npos) << Describe(off);
 }
 
 }  // namespace

@@ -1,7 +1,9 @@
 // Downstream use of an installed voxplan, written as in-tree code reads: fuse one synthetic
 // depth frame of a wall 1 m in front of the camera, then check the signed distance around it,
-// the extracted mesh against the true wall (voxplan::eval), and a map file round trip. Prints
-// what failed and exits 1, or prints a summary and exits 0.
+// the extracted mesh against the true wall (voxplan::eval), a map file round trip and the depth
+// frame read back from a 16-bit PNG by ReadDepthImage (whose file also holds the TIFF and EXR
+// readers: linked with libtiff and OpenEXR as the package states). Prints what failed and exits 1,
+// or prints a summary and exits 0.
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
@@ -16,6 +18,8 @@
 #include "eval/eval_mesh.h"
 #include "fusion/integrate.h"
 #include "fusion/mesh_extract.h"
+#include "io/depth_image.h"
+#include "io/image_io.h"
 #include "io/map_io.h"
 
 namespace {
@@ -69,6 +73,16 @@ int main(int argc, char** argv) {
   if (!loaded.ok()) return Fail("LoadMap: " + loaded.status().message());
   if (ExtractMesh(*loaded).num_triangles() != mesh.num_triangles())
     return Fail("loaded map meshes differently");
+
+  // The depth frame as a dataset's 16-bit PNG, read back as the dataset readers read depth.
+  const std::string png = (std::filesystem::path(argv[1]) / "wall_depth.png").string();
+  if (const Status written = WriteDepthPng16(png, depth, 1000.0); !written.ok())
+    return Fail("WriteDepthPng16: " + written.message());
+  const Result<DepthImage> read = ReadDepthImage(png, 1000.0);
+  if (!read.ok()) return Fail("ReadDepthImage: " + read.status().message());
+  if (read->width != depth.width || read->height != depth.height ||
+      std::fabs(read->at(7, 5) - kWallZM) > 1e-3f)
+    return Fail("the depth PNG reads back differently");
 
   std::printf("downstream: %zu blocks, %zu triangles, accuracy %.5f m\n", stats->blocks_allocated,
               mesh.num_triangles(), score->accuracy_mean_m);
