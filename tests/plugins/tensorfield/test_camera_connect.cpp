@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "plugins/tensorfield/algorithms/camera_path.h"
+#include "tests/plugins/tensorfield/camera_test_paths.h"
 
 namespace voxplan::tensorfield {
 namespace {
@@ -19,16 +20,8 @@ constexpr float kAngleTolRad = 1e-5f;
 constexpr float kPositionTolM = 1e-5f;
 constexpr float kWorkspaceTolM = 1e-4f;
 
-double Wrap(double a) { return std::remainder(a, 2.0 * kPi); }
-
-std::vector<CameraBaseSample> StraightPath(int samples, float spacing_m) {
-  std::vector<CameraBaseSample> path;
-  for (int s = 0; s < samples; ++s) {
-    const float x = spacing_m * static_cast<float>(s);
-    path.push_back({Eigen::Vector2f(x, 0.0f), 0.0f, x});
-  }
-  return path;
-}
+using test::StraightPath;
+using test::Wrap;
 
 // An optimised trajectory along a straight 9 m path (the arm's default workspace): the views
 // look half left and a little down, higher is better.

@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "plugins/tensorfield/algorithms/camera_path.h"
+#include "tests/plugins/tensorfield/camera_test_paths.h"
 
 namespace voxplan::tensorfield {
 namespace {
@@ -21,17 +22,8 @@ constexpr float kAngleTolRad = 1e-5f;
 constexpr double kEnergyTol = 1e-9;
 constexpr float kTouchM = 0.25f;  // the robot's radius plus the clearance margin (the planner's)
 
-double Wrap(double a) { return std::remainder(a, 2.0 * kPi); }
-
-// Base samples every spacing_m along +x from the origin (heading 0).
-std::vector<CameraBaseSample> StraightPath(int samples, float spacing_m) {
-  std::vector<CameraBaseSample> path;
-  for (int s = 0; s < samples; ++s) {
-    const float x = spacing_m * static_cast<float>(s);
-    path.push_back({Eigen::Vector2f(x, 0.0f), 0.0f, x});
-  }
-  return path;
-}
+using test::StraightPath;
+using test::Wrap;
 
 // A head: the camera over the base centre (a 1-2 cm ring at 1.2 m), turning on its joint.
 CameraPathParams HeadParams() {
