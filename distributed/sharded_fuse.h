@@ -1,9 +1,9 @@
 #pragma once
 // Fusion with the map split over ranks (`mpirun -n N voxplan fuse`): rank 0 reads and checks
-// every frame once and broadcasts it; every rank walks the frame's truncation band and keeps the
-// blocks it owns (core/shard.h), or with split_band_walk walks its share and sends what it found
-// to the owners; each integrates its blocks with the usual kernels, so each voxel gets exactly
-// the updates it gets in one process. Tracking needs the whole model each frame and is
+// every frame once and broadcasts it; each rank walks its share of the frame's truncation band
+// and sends the blocks it found to their owners (core/shard.h), or without split_band_walk walks
+// all of it and keeps its own; each integrates its blocks with the usual kernels, so each voxel
+// gets exactly the updates it gets in one process. Tracking needs the whole model each frame and is
 // not supported here (refused). Checkpoints are sharded maps (distributed/sharded_map.h) with
 // the run's frame cursor; a resumed run continues from the last one, under any rank count.
 // The same code runs in one process with a SerialCommunicator (checkpoints and resume there too).
@@ -34,10 +34,10 @@ struct ShardedFuseParams {
   size_t checkpoint_every = 0;  // selected frames between checkpoints; 0: none
   bool resume = false;          // continue from the checkpoint at checkpoint_path
   // Each rank walks its share of a frame's band and the ranks exchange the blocks found
-  // (IntegrateParams::band_exchange), instead of every rank walking all of it. Same map; off by
-  // default: on shared memory the exchange (a synchronisation of all ranks) cost more than the
-  // walk it saves (distributed/README.md).
-  bool split_band_walk = false;
+  // (IntegrateParams::band_exchange), instead of every rank walking all of it. Same map. The
+  // exchange waits for every rank: with more ranks than cores (time-sliced) the whole walk is
+  // faster (distributed/README.md).
+  bool split_band_walk = true;
   // Whatever must match for a checkpoint to be resumed: dataset, selection, parameters.
   nlohmann::json fingerprint;
 };

@@ -330,10 +330,9 @@ Command AddFuseCommand(CLI::App& app) {
                 "Continue the run whose checkpoint is --map (same dataset, frames and "
                 "parameters; any rank count)");
   sub->add_option("--band-walk", o->band_walk,
-                  "Under mpirun: every rank walks each frame's whole band to find its blocks, or "
-                  "each walks a share and the ranks send what they found to the owners (same map; "
-                  "split pays only where the exchange is cheaper than the walk, see "
-                  "distributed/README.md)")
+                  "Under mpirun: each rank walks a share of each frame's band and the ranks send "
+                  "the blocks they found to their owners, or every rank walks the whole band (same "
+                  "map; whole is faster with more ranks than cores, see distributed/README.md)")
       ->check(CLI::IsMember({"split", "whole"}))
       ->capture_default_str();
   sub->add_option("--prefetch", o->prefetch,

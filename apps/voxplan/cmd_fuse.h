@@ -32,7 +32,7 @@ struct FuseOptions {
   size_t prefetch = FuseParams::kDefaultPrefetch;
   size_t checkpoint_every = 0;      // selected frames between checkpoints of --map (0: none)
   bool resume = false;              // continue the run whose checkpoint --map is
-  std::string band_walk = "whole";  // under mpirun: every rank walks the band, or "split" it
+  std::string band_walk = "split";  // under mpirun: split the band walk over the ranks, or "whole"
 };
 
 // The stats object: the same on the last stdout line and in --stats.

@@ -56,9 +56,9 @@ void ExpectSameOnAnyRankCount(const test::TempDir& dir, const std::vector<std::s
   ASSERT_EQ(base.exit_code, 0) << Describe(base);
   const std::string checksum = Checksum(map1), mesh = ReadAll(mesh1);
   ASSERT_GT(mesh.size(), 10000u);
-  // 2 ranks twice: with the whole band walked on every rank (the default) and split.
+  // 2 ranks twice: with the band walk split (the default) and whole on every rank.
   for (const auto& [ranks, walk] : std::vector<std::pair<int, std::string>>{
-           {1, "whole"}, {2, "whole"}, {2, "split"}, {4, "split"}}) {
+           {1, "split"}, {2, "split"}, {2, "whole"}, {4, "whole"}}) {
     const std::string tag = Numbered("r", ranks, walk);
     const fs::path map = dir / (tag + ".vpmap"), mesh_path = dir / (tag + ".ply");
     std::vector<std::string> split = args;
