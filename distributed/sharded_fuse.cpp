@@ -210,14 +210,14 @@ FuseReport Concatenate(const FuseReport& resumed, const FuseReport& more) {
   return r;
 }
 
+}  // namespace
+
 nlohmann::json CheckpointRun(const ShardedFuseParams& params, size_t done,
                              const FuseReport& report) {
   return {{"fingerprint", params.fingerprint},
           {"frames_done", done},
           {"report", FuseReportToJson(report)}};
 }
-
-}  // namespace
 
 nlohmann::json FuseReportToJson(const FuseReport& report) {
   nlohmann::json frames = nlohmann::json::array();

@@ -76,6 +76,11 @@ struct RankFigures {
 };
 Result<std::vector<RankFigures>> GatherRankFigures(Communicator& comm, const TsdfVolume& local);
 
+// What a sharded map records of the run that wrote it (ShardManifest::run_json): the run's
+// fingerprint, the selected frames done and the report so far — checkpoints and the final map.
+nlohmann::json CheckpointRun(const ShardedFuseParams& params, size_t done,
+                             const FuseReport& report);
+
 // A fuse report as JSON and back, as checkpoints keep it (frames with their poses bit-exact).
 nlohmann::json FuseReportToJson(const FuseReport& report);
 Result<FuseReport> FuseReportFromJson(const nlohmann::json& j);

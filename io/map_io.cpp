@@ -10,6 +10,7 @@
 #include <optional>
 #include <type_traits>
 
+#include "core/fnv1a.h"  // streamed, so neither save nor load holds a second copy
 #include "io/file_util.h"
 
 namespace voxplan {
@@ -33,21 +34,6 @@ constexpr size_t HeaderBytes(uint32_t version) {
 constexpr size_t kBlockRecordBytes = 3 * sizeof(int32_t) + sizeof(TsdfBlock);
 constexpr size_t kChecksumBytes = 8;
 static_assert(sizeof(kMagic) == 8);
-
-// FNV-1a 64, updated as bytes stream past so neither save nor load holds a second copy.
-class Fnv1a64 {
- public:
-  void Update(const void* data, size_t n) {
-    const auto* p = static_cast<const unsigned char*>(data);
-    uint64_t h = hash_;
-    for (size_t i = 0; i < n; ++i) h = (h ^ p[i]) * 0x100000001b3ull;
-    hash_ = h;
-  }
-  uint64_t value() const { return hash_; }
-
- private:
-  uint64_t hash_ = 0xcbf29ce484222325ull;
-};
 
 struct FileCloser {
   void operator()(std::FILE* f) const { std::fclose(f); }

@@ -7,6 +7,7 @@
 #include <fstream>
 #include <nlohmann/json.hpp>
 
+#include "core/fnv1a.h"
 #include "io/file_util.h"
 #include "io/map_io.h"
 
@@ -72,17 +73,13 @@ std::string ShardManifestText(const ShardManifest& m) {
 }
 
 uint64_t VolumeChecksum(const TsdfVolume& volume) {
-  uint64_t h = 0xcbf29ce484222325ull;
-  const auto update = [&](const void* data, size_t n) {
-    const auto* p = static_cast<const unsigned char*>(data);
-    for (size_t i = 0; i < n; ++i) h = (h ^ p[i]) * 0x100000001b3ull;
-  };
+  Fnv1a64 hash;
   for (const BlockIndex& b : volume.SortedBlockIndices()) {
     const int32_t xyz[3] = {b.x, b.y, b.z};
-    update(xyz, sizeof(xyz));
-    update(volume.FindBlock(b), sizeof(TsdfBlock));
+    hash.Update(xyz, sizeof(xyz));
+    hash.Update(volume.FindBlock(b), sizeof(TsdfBlock));
   }
-  return h;
+  return hash.value();
 }
 
 bool IsShardedMapFile(const std::string& path) {

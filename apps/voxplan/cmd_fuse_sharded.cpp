@@ -7,6 +7,7 @@
 #include "apps/voxplan/cmd_fuse.h"
 #include "apps/voxplan/progress.h"
 #include "apps/voxplan/signals.h"
+#include "core/fnv1a.h"
 #include "core/parallel.h"
 #include "core/summary.h"
 #include "distributed/sharded_fuse.h"
@@ -29,13 +30,15 @@ int AgreeOnExit(Communicator& comm, int code) {
 // What a checkpoint must share with the run resuming it.
 nlohmann::json Fingerprint(const FuseOptions& o, const DatasetInfo& info,
                            const std::vector<size_t>& indices) {
-  uint64_t h = 0xcbf29ce484222325ull;  // FNV-1a over the selected frames
-  for (size_t i : indices)
-    for (int b = 0; b < 8; ++b) h = (h ^ ((uint64_t(i) >> (8 * b)) & 0xff)) * 0x100000001b3ull;
+  Fnv1a64 selected;  // over the selected frames' indices, 8 little-endian bytes each
+  for (size_t i : indices) {
+    const uint64_t index = i;
+    selected.Update(&index, sizeof(index));
+  }
   return {{"dataset", info.root},
           {"format", DatasetFormatName(info.format)},
           {"frames_selected", indices.size()},
-          {"frames_hash", std::to_string(h)},
+          {"frames_hash", std::to_string(selected.value())},
           {"voxel_size_m", o.voxel_size_m},
           {"trunc_m", o.trunc_m},
           {"min_depth_m", o.in.min_depth_m},
@@ -159,9 +162,7 @@ int RunFuseSharded(const FuseOptions& o, Communicator& comm) {
   if (!o.map_path.empty()) {
     Status s = Status::Ok();
     const uint64_t generation = uint64_t(indices.size());
-    const nlohmann::json run = {{"fingerprint", params.fingerprint},
-                                {"frames_done", indices.size()},
-                                {"report", FuseReportToJson(report)}};
+    const nlohmann::json run = CheckpointRun(params, indices.size(), report);
     const ShardManifest* previous = fused->checkpoint ? &*fused->checkpoint : nullptr;
     if (split) {
       Result<ShardManifest> m = WriteShardedMap(comm, local, o.map_path, generation,
