@@ -92,6 +92,17 @@ void AddMemoryBudgetOptions(CLI::App* sub, MemoryBudgetOptions& o, bool with_on_
       ->capture_default_str();
 }
 
+Result<std::pair<int, int>> ParseImageSize(const std::string& text) {
+  int width = 0, height = 0;
+  char x = 0, extra = 0;
+  std::istringstream in(text);
+  if (!(in >> width >> x >> height) || (x != 'x' && x != 'X') || (in >> extra)) {
+    return InvalidArgument("--size wants WxH, e.g. 640x480: " + text);
+  }
+  VOXPLAN_RETURN_IF_ERROR(bounds::CheckImageSize("image size", width, height));
+  return std::pair(width, height);
+}
+
 Result<uint64_t> ParseMemorySize(const std::string& text) {
   std::string range = "[";  // appended: GCC 12 warns (-Wrestrict, falsely) on "[" + std::string
   range += std::to_string(bounds::kMemoryMinBytes >> 20);

@@ -4,6 +4,7 @@
 #include <CLI/CLI.hpp>
 #include <cstdint>
 #include <string>
+#include <utility>
 
 #include "core/volume.h"
 #include "pipeline/fuse_dataset.h"
@@ -36,6 +37,8 @@ void AddMemoryBudgetOptions(CLI::App* sub, MemoryBudgetOptions& o, bool with_on_
 // "512M", "4G", "1.5G", "65536K", "1073741824" (bytes): 1024-based, within core/bounds.h's
 // memory range; the message says what is wrong.
 Result<uint64_t> ParseMemorySize(const std::string& text);
+// "WxH" (or "WXH"), each side and the pixel count within bounds::CheckImageSize's.
+Result<std::pair<int, int>> ParseImageSize(const std::string& text);
 // Half the machine's memory: physical memory, or the cgroup's limit where that is lower.
 uint64_t DefaultMemoryBudget();
 // The budget in bytes (the option's, or the default) and what to do past it.

@@ -79,11 +79,9 @@ Result<ObservableViews> ReadObservableViews(const EvalMeshOptions& o) {
   if (!std::filesystem::is_regular_file(o.observable_from, ec))
     return NotFound("--observable-from: no dataset folder or trajectory file at " +
                     o.observable_from);
-  int width = 0, height = 0, consumed = 0;
-  if (std::sscanf(o.size.c_str(), "%dx%d%n", &width, &height, &consumed) != 2 ||
-      consumed != int(o.size.size()))
-    return InvalidArgument("--size wants WIDTHxHEIGHT (e.g. 640x480), got '" + o.size + "'");
-  VOXPLAN_RETURN_IF_ERROR(bounds::CheckImageSize("--size", width, height));
+  const Result<std::pair<int, int>> size = ParseImageSize(o.size);
+  if (!size.ok()) return size.status();
+  const auto [width, height] = *size;
   // sim render's defaults: fx = fy = 525, principal point at the image centre.
   views.camera = intrinsics.value_or(
       PinholeCamera{0, 0, 525.f, 525.f, 0.5f * float(width - 1), 0.5f * float(height - 1)});

@@ -51,17 +51,6 @@ struct RenderOptions {
   std::string dollhouse = "auto";  // auto: on for orbits
 };
 
-Result<std::pair<int, int>> ParseSize(const std::string& text) {
-  int width = 0, height = 0;
-  char x = 0, extra = 0;
-  std::istringstream in(text);
-  if (!(in >> width >> x >> height) || (x != 'x' && x != 'X') || (in >> extra)) {
-    return InvalidArgument("--size wants WxH, e.g. 640x480: " + text);
-  }
-  VOXPLAN_RETURN_IF_ERROR(bounds::CheckImageSize("image size", width, height));
-  return std::pair(width, height);
-}
-
 Result<Pose3f> ParsePose(const std::string& text) {
   double v[7];
   std::istringstream in(text);
@@ -135,7 +124,7 @@ int RunRender(const RenderOptions& o) {
   std::error_code ec;
   if (!fs::is_regular_file(o.input, ec)) return Fail("input file not found: " + o.input);
   RenderViewsParams params;
-  std::tie(params.width, params.height) = *ParseSize(o.size);  // checked by the validator
+  std::tie(params.width, params.height) = *ParseImageSize(o.size);  // checked by the validator
   params.mode = *ParseShadeMode(o.mode);
   params.fov_deg = float(o.fov_deg);
   if (o.orbit_radius_m > 0.0) params.orbit_radius_m = float(o.orbit_radius_m);
@@ -261,7 +250,7 @@ int RunRender(const RenderOptions& o) {
   return kExitOk;
 }
 
-// Refuses what `parse` (ParseSize, ParsePose) refuses, with its message.
+// Refuses what `parse` (ParseImageSize, ParsePose) refuses, with its message.
 template <class T>
 CLI::Validator ParsedBy(Result<T> (*parse)(const std::string&), const std::string& description) {
   return CLI::Validator(
@@ -349,7 +338,7 @@ Command AddRenderCommand(CLI::App& app) {
       ->check(CLI::IsMember({"shaded", "normals", "colour", "color", "depth"}))
       ->capture_default_str();
   sub->add_option("--size", o->size, "Image size WxH (with --dataset: the dataset's)")
-      ->check(ParsedBy(&ParseSize, "WxH"))
+      ->check(ParsedBy(&ParseImageSize, "WxH"))
       ->capture_default_str()
       ->excludes(dataset);
   sub->add_option("--fov-deg", o->fov_deg, "Horizontal field of view (degrees)")

@@ -37,12 +37,6 @@ struct SimRenderOptions {
   int threads = 0;
 };
 
-bool ParseSize(const std::string& text, int& w, int& h) {
-  int consumed = 0;
-  if (std::sscanf(text.c_str(), "%dx%d%n", &w, &h, &consumed) != 2) return false;
-  return consumed == int(text.size()) && bounds::CheckImageSize("--size", w, h).ok();
-}
-
 // id, class, model of every instance: what the label images' ids mean.
 Status WriteInstanceClasses(const World& world, const std::string& path) {
   std::string text = "id\tclass\tmodel\n";
@@ -53,12 +47,9 @@ Status WriteInstanceClasses(const World& world, const std::string& path) {
 
 int RunSimRender(const SimRenderOptions& o) {
   // Usage checks, before any work.
-  int width = 0, height = 0;
-  if (!ParseSize(o.size, width, height))
-    return Fail("--size wants WIDTHxHEIGHT, 1 to " + std::to_string(bounds::kImageSideMax) +
-                    " per side and at most " + std::to_string(bounds::kImagePixelsMax) +
-                    " pixels (e.g. 640x480), got '" + o.size + "'",
-                kExitUsage);
+  const Result<std::pair<int, int>> size = ParseImageSize(o.size);
+  if (!size.ok()) return Fail(size.status().message(), kExitUsage);
+  const auto [width, height] = *size;
   if (o.noise != "on" && o.noise != "off")
     return Fail("--noise must be on or off, got '" + o.noise + "'", kExitUsage);
   std::error_code ec;

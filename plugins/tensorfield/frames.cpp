@@ -24,6 +24,11 @@ FloorWindow CropFloor(const FloorInput& floor, const Eigen::Vector2d& centre_m, 
   w.raster.cells.assign(n, omt::Cell::kUnknown);
   w.clearance.geometry = w.geometry;
   w.clearance.clearance_m.assign(n, 0.f);
+  const bool surface = !floor.surface.empty();
+  if (surface) {
+    w.surface.uncertainty.assign(n, 0.f);
+    w.surface.normal.assign(n, Eigen::Vector2f::Zero());
+  }
   for (int y = 0; y < w.geometry.height; ++y) {
     const int fy = w.y0 + y;
     if (fy < 0 || fy >= fg.height) continue;
@@ -38,6 +43,10 @@ FloorWindow CropFloor(const FloorInput& floor, const Eigen::Vector2d& centre_m, 
                             : code == kFloorFree || code == kFloorFrontier ? omt::Cell::kFree
                                                                            : omt::Cell::kUnknown;
       w.clearance.clearance_m[dst] = floor.clearance_m[src];
+      if (surface) {
+        w.surface.uncertainty[dst] = floor.surface.uncertainty[src];
+        w.surface.normal[dst] = floor.surface.normal[src];
+      }
     }
   }
   return w;

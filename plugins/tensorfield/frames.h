@@ -23,11 +23,20 @@ enum FloorCode : std::uint8_t {
   kFloorObstacle = 3
 };
 
+// The host's surface voxels in the floor band, per floor cell (the gain's surface term): both
+// empty when the planner does not read them.
+struct SurfaceCells {
+  std::vector<float> uncertainty;       // the cell's least-observed voxel, 0 none, 1 unobserved
+  std::vector<Eigen::Vector2f> normal;  // unit xy of the voxels' summed normals; zero: unknown
+  bool empty() const { return uncertainty.empty(); }
+};
+
 // The host's floor raster as plain data (row-major, cell (x, y) covers origin + [x, x+1) * res).
 struct FloorInput {
   omt::RasterGeometry geometry;
   std::vector<std::uint8_t> cells;  // FloorCode per cell
   std::vector<float> clearance_m;   // the host's: cell centre to the nearest obstacle cell
+  SurfaceCells surface;             // on the same cells, or empty
 };
 
 // A square crop of the floor on its own grid: window cell (x, y) is floor cell (x0 + x, y0 + y);
@@ -38,6 +47,7 @@ struct FloorWindow {
   std::vector<std::uint8_t> codes;  // FloorCode
   omt::OccupancyRaster raster;      // obstacle -> occupied, free and frontier -> free
   omt::ClearanceRaster clearance;   // the host's clearance, cropped
+  SurfaceCells surface;             // the floor's, cropped (empty when it has none)
 };
 
 // The window of half-width radius_m (rounded up to cells) centred on the floor cell holding

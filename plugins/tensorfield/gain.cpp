@@ -8,9 +8,18 @@
 
 namespace voxplan::tensorfield {
 
+double SurfaceProfile(double distance_m, double range_m) {
+  if (range_m <= 0.0) return 0.0;
+  return std::clamp(2.0 * (1.0 - distance_m / range_m), 0.0, 1.0);
+}
+
 ViewGain::ViewGain(const omt::RasterGeometry& geometry, std::vector<std::uint8_t> codes,
-                   const GainParams& params)
+                   const GainParams& params, SurfaceCells surface)
     : geometry_(geometry), params_(params) {
+  if (params_.surface_depth_m > 0.0 &&
+      surface.uncertainty.size() == static_cast<std::size_t>(geometry.NumCells()) &&
+      surface.normal.size() == surface.uncertainty.size())
+    surface_ = std::move(surface);
   params_.rays = std::max(8, params_.rays);
   unseen_.resize(codes.size());
   for (std::size_t i = 0; i < codes.size(); ++i)
@@ -32,16 +41,40 @@ std::vector<double> ViewGain::Sectors(const Eigen::Vector2d& p_m) const {
     const double a = dtheta * k;
     const Eigen::Vector2d d(std::cos(a), std::sin(a));
     double area = 0.0;
+    int previous = -1;
     for (double t = 0.5 * step; t <= params_.range_m; t += step) {
       const int c = geometry_.IndexOf(p_m + t * d);
       if (c < 0) break;
       const std::uint8_t u = unseen_[static_cast<std::size_t>(c)];
-      if (u == 2) break;
+      if (u == 2) {
+        if (!surface_.empty() && t >= params_.near_m)
+          area += SurfaceTerm(c, previous, d) * SurfaceProfile(t, params_.range_m) * t * dtheta *
+                  params_.surface_depth_m;
+        break;
+      }
       if (u == 1 && t >= params_.near_m) area += t * step * dtheta;
+      previous = c;
     }
     out[static_cast<std::size_t>(k)] = area;
   }
   return out;
+}
+
+// The uncertainty x cos(incidence) of the surface a ray along d meets at obstacle cell c: its
+// voxels may sit in c or, at the zero crossing, in the free cell before it, so the larger of
+// the two. A cell without a normal counts as faced squarely.
+double ViewGain::SurfaceTerm(int c, int previous, const Eigen::Vector2d& d) const {
+  double best = 0.0;
+  for (const int cell : {c, previous}) {
+    if (cell < 0) continue;
+    const std::size_t i = static_cast<std::size_t>(cell);
+    const double u = surface_.uncertainty[i];
+    if (u <= 0.0) continue;
+    const Eigen::Vector2f& n = surface_.normal[i];
+    const double facing = n.squaredNorm() > 0.f ? std::max(0.0, -d.dot(n.cast<double>())) : 1.0;
+    best = std::max(best, u * facing);
+  }
+  return best;
 }
 
 ViewChoice ViewGain::Best(const Eigen::Vector2d& p_m, double centre_rad,

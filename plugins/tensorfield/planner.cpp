@@ -442,7 +442,7 @@ void RobotPlanner::SettleAround(const FloorInput& floor, const Eigen::Vector2d& 
 }
 
 // The gain model on the current window; settled cells count as seen.
-ViewGain RobotPlanner::GainModel(const RobotInput& robot) const {
+ViewGain RobotPlanner::GainModel(const RobotInput& robot, bool with_surface) const {
   std::vector<std::uint8_t> codes = window_.codes;
   for (int i = 0; i < window_.geometry.NumCells() && !settled_.empty(); ++i)
     if (settled_.count(KeyOf(window_.geometry, i)) > 0)
@@ -451,7 +451,10 @@ ViewGain RobotPlanner::GainModel(const RobotInput& robot) const {
   gp.range_m = robot.max_range_m;
   gp.near_m = std::max(0.3, robot.min_range_m);
   gp.fov_rad = robot.fov_rad;
-  return ViewGain(window_.geometry, std::move(codes), gp);
+  if (!with_surface || options_.surface_depth_m <= 0.0 || window_.surface.empty())
+    return ViewGain(window_.geometry, std::move(codes), gp);
+  gp.surface_depth_m = options_.surface_depth_m;
+  return ViewGain(window_.geometry, std::move(codes), gp, window_.surface);
 }
 
 StepOutput RobotPlanner::Step(const FloorInput& floor, const RobotInput& robot, double sim_time_s,

@@ -67,7 +67,12 @@ struct PlannerOptions {
   // (CameraPathParams::start_from_camera), then the same connection; kOff, it starts at the
   // optimised trajectory's first view and the host turns the camera there at its joints' rate.
   CameraConnect connect = CameraConnect::kSpline;
-  double gain_threshold = 0.01;      // X L229
+  double gain_threshold = 0.01;  // X L229
+  // The camera views' surface term (gain.h GainParams::surface_depth_m; 0 off) over the host's
+  // surface voxels from the floor up to surface_band_m. The routing and termination gains leave
+  // it out: a surface the sensor cannot resolve from the floor would hold the run open.
+  double surface_depth_m = 0.0;
+  double surface_band_m = 1.8;       // planning/floor_map.h's band: the robot's height
   double clearance_margin_m = 0.05;  // beyond the robot radius, as the host's own routes keep
   double lookahead_m = 2.0;          // the pathline the camera is planned along
   double camera_sample_m = 0.3;      // its samples
@@ -205,7 +210,8 @@ class RobotPlanner {
   void BuildTopology(const RobotInput& robot, const ViewGain& gain, StepOutput* out);
   void AddGlyphs(const TensorRaster& frame, StepOutput* out) const;
   SkeletonParams SkeletonFor(const RobotInput& robot) const;
-  ViewGain GainModel(const RobotInput& robot) const;
+  // with_surface: the surface term too (when the options ask for it).
+  ViewGain GainModel(const RobotInput& robot, bool with_surface = false) const;
   Pathline Advect(const RobotInput& robot, double heading_rad, double length_m,
                   const std::vector<DegeneratePoint>& points) const;
   bool Traversable(const Eigen::Vector2d& p, double radius_m) const;
@@ -229,7 +235,7 @@ class RobotPlanner {
   // stop: the caller knows this call is a stop (a route or a re-advection starts); EmitLine adds
   // the other kinds (StepDiagnostics::camera_stop).
   void EmitLine(const std::vector<Eigen::Vector2d>& line, const std::vector<float>& speeds,
-                const RobotInput& robot, const ViewGain& gain, bool stop, StepOutput* out);
+                const RobotInput& robot, const ViewGain& route_gain, bool stop, StepOutput* out);
   std::vector<CameraLookAtTarget> LookAtTargets(const std::vector<Eigen::Vector2d>& line,
                                                 const RobotInput& robot) const;
   // Where the arm camera is now by the last trajectory sent (NaN: not known).

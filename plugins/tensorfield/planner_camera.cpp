@@ -100,9 +100,14 @@ Eigen::Vector3f RobotPlanner::ArmCameraNow(const RobotInput& robot) const {
 
 void RobotPlanner::EmitLine(const std::vector<Eigen::Vector2d>& line,
                             const std::vector<float>& speeds, const RobotInput& robot,
-                            const ViewGain& gain, bool stop, StepOutput* out) {
+                            const ViewGain& route_gain, bool stop, StepOutput* out) {
   const auto t0 = std::chrono::steady_clock::now();
   if (line.empty()) return;
+  // The camera's views weigh surface uncertainty too, when the options ask for it.
+  std::optional<ViewGain> surface_gain;
+  if (options_.surface_depth_m > 0.0 && !window_.surface.empty())
+    surface_gain.emplace(GainModel(robot, true));
+  const ViewGain& gain = surface_gain ? *surface_gain : route_gain;
   // Arc length and time at every point (the speed of point i is that of the piece ending there).
   std::vector<double> arc(line.size(), 0.0), time(line.size(), 0.0);
   for (std::size_t i = 1; i < line.size(); ++i) {

@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cmath>
 #include <map>
+#include <span>
 #include <string>
 #include <vector>
 
@@ -52,6 +53,8 @@ PlannerOptions ReadOptions(const std::string& json_text) {
               : connect == "selection" ? CameraConnect::kInSelection
                                        : CameraConnect::kSpline;
   o.gain_threshold = json.Number("gain_threshold", o.gain_threshold, 0.0, 1.0);
+  o.surface_depth_m = json.Number("surface_depth_m", o.surface_depth_m, 0.0, 10.0);
+  o.surface_band_m = json.Number("surface_band_m", o.surface_band_m, 0.1, 10.0);
   const std::string field =
       json.Choice("field", "tensor", {"tensor", "vector_normal", "vector_tangent"});
   o.field = field == "vector_normal"    ? FieldKind::kVectorNormal
@@ -77,6 +80,30 @@ FloorInput ReadFloor(const vp::FloorView& f) {
   floor.cells.assign(f.cells().begin(), f.cells().end());
   floor.clearance_m.assign(f.clearance_m().begin(), f.clearance_m().end());
   return floor;
+}
+
+// The surface voxels from the floor up to band_m over the floor's cells: each cell's largest
+// uncertainty and its voxels' summed normals in the plane (unit; zero when they cancel or none
+// has a normal).
+SurfaceCells ReadSurface(std::span<const vp_surface_voxel> voxels,
+                         const omt::RasterGeometry& geometry, float floor_z_m, double band_m) {
+  SurfaceCells s;
+  const std::size_t n = static_cast<std::size_t>(geometry.NumCells());
+  s.uncertainty.assign(n, 0.f);
+  s.normal.assign(n, Eigen::Vector2f::Zero());
+  for (const vp_surface_voxel& v : voxels) {
+    const float z = v.position[2] - floor_z_m;
+    if (!(z >= 0.f && z <= float(band_m)) || !std::isfinite(v.uncertainty)) continue;
+    const int c = geometry.IndexOf(Eigen::Vector2d(v.position[0], v.position[1]));
+    if (c < 0) continue;
+    const std::size_t i = static_cast<std::size_t>(c);
+    s.uncertainty[i] = std::max(s.uncertainty[i], std::clamp(v.uncertainty, 0.f, 1.f));
+    if (std::isfinite(v.normal[0]) && std::isfinite(v.normal[1]))
+      s.normal[i] += Eigen::Vector2f(v.normal[0], v.normal[1]);
+  }
+  for (Eigen::Vector2f& v : s.normal)
+    v = v.norm() > 1e-3f ? v.normalized() : Eigen::Vector2f::Zero();
+  return s;
 }
 
 RobotInput ReadRobot(const vp::WorldView& world, uint32_t r, const vp_map_info& map) {
@@ -137,7 +164,10 @@ class TensorfieldPlanner : public vp::Planner {
     const vp_map_info map = world.MapInfo();
     const vp::FloorView floor_view = world.Floor();
     if (floor_view.width() <= 0 || floor_view.height() <= 0) return;
-    const FloorInput floor = ReadFloor(floor_view);
+    FloorInput floor = ReadFloor(floor_view);
+    if (options_.surface_depth_m > 0.0)
+      floor.surface = ReadSurface(world.SurfaceVoxels(), floor.geometry, map.floor_z_m,
+                                  options_.surface_band_m);
     RouteServices services;
     services.geodesic = [&](const Eigen::Vector2d& from, double clearance) {
       const std::span<const float> f =

@@ -87,13 +87,15 @@ TEST(Tensorfield, LoadsWithDefaultsAndRefusesUnknownKeysAndBadValues) {
                           R"({"interp": "cubic"})", R"({"camera": "free"})", R"({"frames_k": 1})",
                           R"({"substeps_per_keyframe": 11})", R"({"gain_threshold": -1})",
                           R"({"topology_routing": "yes"})", R"({"field": "vector_radial"})",
-                          R"({"method": "gradient"})"}) {
+                          R"({"method": "gradient"})", R"({"surface_depth_m": -0.1})",
+                          R"({"surface_depth_m": 11})", R"({"surface_band_m": 0})"}) {
     PlannerLoadOptions o;
     o.config_json = bad;
     EXPECT_FALSE(LoadPlanner("tensorfield", o).ok()) << bad;
   }
   for (const char* good : {R"({"field": "vector_normal"})", R"({"field": "vector_tangent"})",
-                           R"({"method": "potential"})", R"({"method": "harmonic"})"})
+                           R"({"method": "potential"})", R"({"method": "harmonic"})",
+                           R"({"surface_depth_m": 0.5, "surface_band_m": 1.2})"})
     EXPECT_TRUE(Load(good)) << good;
   // A vector field belongs to the tensor method's pipeline; the potential methods have none.
   PlannerLoadOptions o;
@@ -209,6 +211,29 @@ TEST(Tensorfield, TheFixedCameraLooksAlongThePathAndPlansAreDeterministic) {
   ASSERT_EQ(a.robots[0].camera_trajectory.size(), b.robots[0].camera_trajectory.size());
   for (size_t i = 0; i < a.robots[0].camera_trajectory.size(); ++i)
     EXPECT_EQ(a.robots[0].camera_trajectory[i].yaw_rad, b.robots[0].camera_trajectory[i].yaw_rad);
+}
+
+// The surface term reads the host's surface voxels (the fake world's: every wall cell next to
+// free floor, weight 2): the camera's views turn from the unknown ahead towards the walls, and
+// the plan stays deterministic; the base's path does not use the term.
+TEST(Tensorfield, TheSurfaceTermMovesOnlyTheCamerasViewsAndIsDeterministic) {
+  test::RasterWorld world = Corridor();
+  const char* config = R"({"surface_depth_m": 5.0})";
+  const PlanResult a = MustPlan(*Load(config), world, At(1.0));
+  const PlanResult b = MustPlan(*Load(config), world, At(1.0));
+  const PlanResult off = MustPlan(*Load(), world, At(1.0));
+  const RobotPlan &pa = a.robots[0], &pb = b.robots[0], &po = off.robots[0];
+  ASSERT_FALSE(pa.camera_trajectory.empty());
+  ASSERT_EQ(pa.camera_trajectory.size(), pb.camera_trajectory.size());
+  for (size_t i = 0; i < pa.camera_trajectory.size(); ++i)
+    EXPECT_EQ(pa.camera_trajectory[i].yaw_rad, pb.camera_trajectory[i].yaw_rad);
+  ASSERT_EQ(pa.path.size(), po.path.size());
+  for (size_t i = 0; i < pa.path.size(); ++i)
+    EXPECT_EQ(pa.path[i].position_m, po.path[i].position_m);
+  bool moved = pa.camera_trajectory.size() != po.camera_trajectory.size();
+  for (size_t i = 0; !moved && i < pa.camera_trajectory.size(); ++i)
+    moved = pa.camera_trajectory[i].yaw_rad != po.camera_trajectory[i].yaw_rad;
+  EXPECT_TRUE(moved);
 }
 
 TEST(Tensorfield, TopologyControlReportsItsWorkAndKeepsThePathInFreeSpace) {
