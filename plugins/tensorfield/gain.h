@@ -31,9 +31,15 @@ struct GainParams {
 // the range (depth noise grows with distance, so far views add little weight).
 double SurfaceProfile(double distance_m, double range_m);
 
+// A view's pitch [ours]: the optical axis through the middle of the band from the floor up to
+// band_m, distance_m away (the view's ViewChoice::distance_m), from a camera camera_height_m above
+// the floor. The 2-D gain's unseen cells stand for whole columns of that band.
+double AimPitch(double camera_height_m, double distance_m, double band_m);
+
 struct ViewChoice {
-  double yaw_rad = 0.0;  // world yaw of the view's axis
-  double gain = 0.0;     // unseen area in the fan / the fan's area, in [0, 1]
+  double yaw_rad = 0.0;     // world yaw of the view's axis
+  double gain = 0.0;        // unseen area in the fan / the fan's area, in [0, 1]
+  double distance_m = 0.0;  // the gain-weighted mean distance of what it sees; 0: nothing
 };
 
 class ViewGain {
@@ -46,7 +52,9 @@ class ViewGain {
 
   // Unseen area (m²) of each ray's sector around p, ray k at angle 2πk / rays, with the surface
   // term of the obstacle it stops at.
-  std::vector<double> Sectors(const Eigen::Vector2d& p_m) const;
+  // moments: when given, Σ area × distance per ray.
+  std::vector<double> Sectors(const Eigen::Vector2d& p_m,
+                              std::vector<double>* moments = nullptr) const;
   // The best view at p whose axis lies within half_window_rad of centre_rad (≥ π: any).
   ViewChoice Best(const Eigen::Vector2d& p_m, double centre_rad, double half_window_rad) const;
   // The best view at p in any direction (the I(e, p) of an edge point).

@@ -34,6 +34,11 @@ class ViewGain;  // gain.h
 // (potential_info.h).
 enum class Method : std::uint8_t { kTensor = 0, kHarmonic = 1, kPotential = 2 };
 
+// The camera views' pitch (PlannerOptions::pitch): level (X's figures show a level camera), or
+// aimed at the middle of the floor band at the distance of what the view sees [ours; gain.h
+// AimPitch].
+enum class CameraPitch : std::uint8_t { kLevel = 0, kAim = 1 };
+
 // How a new camera trajectory starts (PlannerOptions::connect).
 enum class CameraConnect : std::uint8_t { kOff = 0, kSpline = 1, kInSelection = 2 };
 
@@ -67,12 +72,15 @@ struct PlannerOptions {
   // (CameraPathParams::start_from_camera), then the same connection; kOff, it starts at the
   // optimised trajectory's first view and the host turns the camera there at its joints' rate.
   CameraConnect connect = CameraConnect::kSpline;
+  CameraPitch pitch = CameraPitch::kLevel;
   double gain_threshold = 0.01;  // X L229
   // The camera views' surface term (gain.h GainParams::surface_depth_m; 0 off) over the host's
-  // surface voxels from the floor up to surface_band_m. The routing and termination gains leave
+  // surface voxels from the floor up to band_m. The routing and termination gains leave
   // it out: a surface the sensor cannot resolve from the floor would hold the run open.
   double surface_depth_m = 0.0;
-  double surface_band_m = 1.8;       // planning/floor_map.h's band: the robot's height
+  // The floor band (planning/floor_map.h's: the robot's height): the surface term's voxels, the
+  // aimed pitch's middle.
+  double band_m = 1.8;
   double clearance_margin_m = 0.05;  // beyond the robot radius, as the host's own routes keep
   double lookahead_m = 2.0;          // the pathline the camera is planned along
   double camera_sample_m = 0.3;      // its samples

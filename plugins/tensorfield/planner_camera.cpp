@@ -228,7 +228,12 @@ void RobotPlanner::EmitLine(const std::vector<Eigen::Vector2d>& line,
       const ViewChoice v = gain.Best(cam.head<2>().cast<double>(), bearing, half_fov);
       CameraViewScore s;
       s.yaw_rad = static_cast<float>(v.yaw_rad);
-      s.pitch_rad = 0.f;
+      if (options_.pitch == CameraPitch::kAim && v.distance_m > 0.0) {
+        const double pitch =
+            AimPitch(double(cam.z()) - robot.floor_z_m, v.distance_m, options_.band_m);
+        s.pitch_rad =
+            static_cast<float>(std::clamp(pitch, robot.min_pitch_rad, robot.max_pitch_rad));
+      }
       s.gain = static_cast<float>(v.gain);
       return s;
     };

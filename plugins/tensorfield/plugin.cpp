@@ -52,9 +52,11 @@ PlannerOptions ReadOptions(const std::string& json_text) {
   o.connect = connect == "off"         ? CameraConnect::kOff
               : connect == "selection" ? CameraConnect::kInSelection
                                        : CameraConnect::kSpline;
+  o.pitch = json.Choice("pitch", "level", {"level", "aim"}) == "aim" ? CameraPitch::kAim
+                                                                     : CameraPitch::kLevel;
   o.gain_threshold = json.Number("gain_threshold", o.gain_threshold, 0.0, 1.0);
   o.surface_depth_m = json.Number("surface_depth_m", o.surface_depth_m, 0.0, 10.0);
-  o.surface_band_m = json.Number("surface_band_m", o.surface_band_m, 0.1, 10.0);
+  o.band_m = json.Number("band_m", o.band_m, 0.1, 10.0);
   const std::string field =
       json.Choice("field", "tensor", {"tensor", "vector_normal", "vector_tangent"});
   o.field = field == "vector_normal"    ? FieldKind::kVectorNormal
@@ -166,8 +168,8 @@ class TensorfieldPlanner : public vp::Planner {
     if (floor_view.width() <= 0 || floor_view.height() <= 0) return;
     FloorInput floor = ReadFloor(floor_view);
     if (options_.surface_depth_m > 0.0)
-      floor.surface = ReadSurface(world.SurfaceVoxels(), floor.geometry, map.floor_z_m,
-                                  options_.surface_band_m);
+      floor.surface =
+          ReadSurface(world.SurfaceVoxels(), floor.geometry, map.floor_z_m, options_.band_m);
     RouteServices services;
     services.geodesic = [&](const Eigen::Vector2d& from, double clearance) {
       const std::span<const float> f =

@@ -83,19 +83,20 @@ TEST(Tensorfield, LoadsWithDefaultsAndRefusesUnknownKeysAndBadValues) {
   ASSERT_TRUE(Load());
   ASSERT_TRUE(Load(R"({"interp": "linear", "topology_routing": false, "camera": "fixed",
                        "substeps_per_keyframe": 10, "substep_s": 0.2})"));
-  for (const char* bad : {R"({"substeps": 5})", R"({"substep_s": 0})", R"({"speed_mps": 5})",
-                          R"({"interp": "cubic"})", R"({"camera": "free"})", R"({"frames_k": 1})",
-                          R"({"substeps_per_keyframe": 11})", R"({"gain_threshold": -1})",
-                          R"({"topology_routing": "yes"})", R"({"field": "vector_radial"})",
-                          R"({"method": "gradient"})", R"({"surface_depth_m": -0.1})",
-                          R"({"surface_depth_m": 11})", R"({"surface_band_m": 0})"}) {
+  for (const char* bad :
+       {R"({"substeps": 5})", R"({"substep_s": 0})", R"({"speed_mps": 5})",
+        R"({"interp": "cubic"})", R"({"camera": "free"})", R"({"frames_k": 1})",
+        R"({"substeps_per_keyframe": 11})", R"({"gain_threshold": -1})",
+        R"({"topology_routing": "yes"})", R"({"field": "vector_radial"})",
+        R"({"method": "gradient"})", R"({"surface_depth_m": -0.1})", R"({"surface_depth_m": 11})",
+        R"({"band_m": 0})", R"({"pitch": "down"})"}) {
     PlannerLoadOptions o;
     o.config_json = bad;
     EXPECT_FALSE(LoadPlanner("tensorfield", o).ok()) << bad;
   }
   for (const char* good : {R"({"field": "vector_normal"})", R"({"field": "vector_tangent"})",
                            R"({"method": "potential"})", R"({"method": "harmonic"})",
-                           R"({"surface_depth_m": 0.5, "surface_band_m": 1.2})"})
+                           R"({"surface_depth_m": 0.5, "band_m": 1.2})", R"({"pitch": "aim"})"})
     EXPECT_TRUE(Load(good)) << good;
   // A vector field belongs to the tensor method's pipeline; the potential methods have none.
   PlannerLoadOptions o;
@@ -234,6 +235,24 @@ TEST(Tensorfield, TheSurfaceTermMovesOnlyTheCamerasViewsAndIsDeterministic) {
   for (size_t i = 0; !moved && i < pa.camera_trajectory.size(); ++i)
     moved = pa.camera_trajectory[i].yaw_rad != po.camera_trajectory[i].yaw_rad;
   EXPECT_TRUE(moved);
+}
+
+// "aim": the views tilt down towards the floor band's middle (the fake world's camera is 1.2 m
+// up, over the 1.8 m band's 0.9 m), within the mount's pitch range; "level" keeps them at 0.
+TEST(Tensorfield, AimedViewsTiltTowardsTheFloorBandsMiddle) {
+  test::RasterWorld world = Corridor();
+  const PlanResult aimed = MustPlan(*Load(R"({"pitch": "aim"})"), world, At(1.0));
+  const PlanResult level = MustPlan(*Load(), world, At(1.0));
+  ASSERT_FALSE(aimed.robots[0].camera_trajectory.empty());
+  int down = 0;
+  for (const CameraSample& s : aimed.robots[0].camera_trajectory) {
+    EXPECT_LE(s.pitch_rad, 1e-6f);
+    EXPECT_GE(s.pitch_rad, world.robots()[0].min_pitch_rad - 1e-6f);
+    down += s.pitch_rad < -0.02f;
+  }
+  EXPECT_GT(down, 0);
+  for (const CameraSample& s : level.robots[0].camera_trajectory)
+    EXPECT_NEAR(s.pitch_rad, 0.f, 1e-6f);
 }
 
 TEST(Tensorfield, TopologyControlReportsItsWorkAndKeepsThePathInFreeSpace) {

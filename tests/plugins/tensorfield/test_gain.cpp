@@ -111,5 +111,34 @@ TEST(ViewGainSurface, TheBestViewTurnsToTheLessObservedWall) {
   EXPECT_LT(std::abs(std::remainder(w.yaw_rad - kPi, 2.0 * kPi)), 0.2);
 }
 
+// An unknown strip x in [1, 2) before the east wall: the best view sees it at the area-weighted
+// mean distance of its cells (∫ t² dt / ∫ t dt over the fan's rays), which AimPitch turns into a
+// tilt through the floor band's middle.
+TEST(ViewGainSurface, TheViewsDistanceIsThatOfWhatItSeesAndAimPitchCentresTheBand) {
+  Room room = MakeRoom(0.f, 0.f);
+  for (int y = 0; y < room.geometry.height; ++y)
+    for (int x = 0; x < room.geometry.width; ++x) {
+      const double cx = room.geometry.Center(x, y).x();
+      if (cx > 1.0 && cx < 2.0)
+        room.codes[static_cast<std::size_t>(room.geometry.Index(x, y))] = kFloorUnknown;
+    }
+  const ViewChoice v = ViewGain(room.geometry, room.codes, Params(0.0)).Best({0, 0}, 0.0, 0.1);
+  ASSERT_GT(v.gain, 0.0);
+  // Along the axis the strip spans t in [1, 2): ∫ t² / ∫ t = 2 (b³ - a³) / 3 (b² - a²); the
+  // rays off the axis (up to 45°) meet it farther out, by up to 1 / cos 45°.
+  const double a = 1.0, b = 2.0;
+  const double on_axis = 2.0 * (b * b * b - a * a * a) / (3.0 * (b * b - a * a));
+  EXPECT_GT(v.distance_m, on_axis - 0.05);
+  EXPECT_LT(v.distance_m, on_axis / std::cos(0.25 * kPi));
+  // A camera 1.2 m up, the band 1.8 m: the axis through z = 0.9 m at that distance.
+  EXPECT_NEAR(AimPitch(1.2, 2.0, 1.8), std::atan2(-0.3, 2.0), 1e-12);
+  EXPECT_NEAR(AimPitch(0.9, 3.0, 1.8), 0.0, 1e-12);
+  EXPECT_GT(AimPitch(0.4, 1.0, 1.8), 0.0);  // a low arm camera looks up
+  // Nothing seen: no distance.
+  const Room known = MakeRoom(0.f, 0.f);
+  EXPECT_EQ(ViewGain(known.geometry, known.codes, Params(0.0)).Best({0, 0}, 0.0, kPi).distance_m,
+            0.0);
+}
+
 }  // namespace
 }  // namespace voxplan::tensorfield
