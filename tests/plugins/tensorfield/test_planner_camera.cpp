@@ -8,6 +8,7 @@
 #include <cmath>
 #include <vector>
 
+#include "plugins/omt/algorithms/raster_ops.h"
 #include "plugins/tensorfield/planner.h"
 
 namespace voxplan::tensorfield {
@@ -37,16 +38,14 @@ FloorInput Corridor() {
       if (inside) code = c.x() >= 4.45 ? kFloorFrontier : kFloorFree;
       if (wall) code = kFloorObstacle;
     }
-  // The host's clearance: to the nearest obstacle cell centre.
-  std::vector<Eigen::Vector2d> obstacles;
-  for (int i = 0; i < g.NumCells(); ++i)
-    if (f.cells[static_cast<std::size_t>(i)] == kFloorObstacle) obstacles.push_back(g.Center(i));
-  f.clearance_m.resize(f.cells.size());
-  for (int i = 0; i < g.NumCells(); ++i) {
-    double d = 1e9;
-    for (const Eigen::Vector2d& o : obstacles) d = std::min(d, (o - g.Center(i)).norm());
-    f.clearance_m[static_cast<std::size_t>(i)] = static_cast<float>(d);
-  }
+  // The host's clearance: to the nearest obstacle cell centre (an exact distance transform; a
+  // brute-force loop over the obstacles took 15 s instrumented).
+  omt::OccupancyRaster occupancy;
+  occupancy.geometry = g;
+  occupancy.cells.resize(f.cells.size(), omt::Cell::kFree);
+  for (std::size_t i = 0; i < f.cells.size(); ++i)
+    if (f.cells[i] == kFloorObstacle) occupancy.cells[i] = omt::Cell::kOccupied;
+  f.clearance_m = omt::ComputeClearance(occupancy, false).clearance_m;
   return f;
 }
 
