@@ -88,10 +88,11 @@ double ViewGain::SurfaceTerm(int c, int previous, const Eigen::Vector2d& d) cons
   return best;
 }
 
-ViewChoice ViewGain::Best(const Eigen::Vector2d& p_m, double centre_rad,
-                          double half_window_rad) const {
+ViewChoice ViewGain::Best(const Eigen::Vector2d& p_m, double centre_rad, double half_window_rad,
+                          bool with_distance) const {
   std::vector<double> m;
-  const std::vector<double> s = Sectors(p_m, &m);
+  const std::vector<double> s = Sectors(p_m, with_distance ? &m : nullptr);
+  if (!with_distance) m.assign(s.size(), 0.0);
   const int rays = params_.rays;
   const double dtheta = 2.0 * omt::kPi / rays;
   // Window starting at ray k covers rays k .. k + window - 1; its axis is their middle.

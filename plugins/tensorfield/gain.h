@@ -56,7 +56,9 @@ class ViewGain {
   std::vector<double> Sectors(const Eigen::Vector2d& p_m,
                               std::vector<double>* moments = nullptr) const;
   // The best view at p whose axis lies within half_window_rad of centre_rad (≥ π: any).
-  ViewChoice Best(const Eigen::Vector2d& p_m, double centre_rad, double half_window_rad) const;
+  // with_distance: fill ViewChoice::distance_m too (else 0).
+  ViewChoice Best(const Eigen::Vector2d& p_m, double centre_rad, double half_window_rad,
+                  bool with_distance = false) const;
   // The best view at p in any direction (the I(e, p) of an edge point).
   double PointGain(const Eigen::Vector2d& p_m) const;
   // The view along yaw_rad exactly.

@@ -225,7 +225,8 @@ void RobotPlanner::EmitLine(const std::vector<Eigen::Vector2d>& line,
       const Eigen::Vector2f off = cam.head<2>() - b.xy_m;
       const double bearing =
           off.norm() > 1e-5f ? std::atan2(double(off.y()), double(off.x())) : double(b.heading_rad);
-      const ViewChoice v = gain.Best(cam.head<2>().cast<double>(), bearing, half_fov);
+      const ViewChoice v = gain.Best(cam.head<2>().cast<double>(), bearing, half_fov,
+                                     options_.pitch == CameraPitch::kAim);
       CameraViewScore s;
       s.yaw_rad = static_cast<float>(v.yaw_rad);
       if (options_.pitch == CameraPitch::kAim && v.distance_m > 0.0) {

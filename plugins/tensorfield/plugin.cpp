@@ -95,7 +95,9 @@ SurfaceCells ReadSurface(std::span<const vp_surface_voxel> voxels,
   s.normal.assign(n, Eigen::Vector2f::Zero());
   for (const vp_surface_voxel& v : voxels) {
     const float z = v.position[2] - floor_z_m;
-    if (!(z >= 0.f && z <= float(band_m)) || !std::isfinite(v.uncertainty)) continue;
+    if (!(z >= 0.f && z <= float(band_m)) || !std::isfinite(v.uncertainty) ||
+        !std::isfinite(v.position[0]) || !std::isfinite(v.position[1]))
+      continue;
     const int c = geometry.IndexOf(Eigen::Vector2d(v.position[0], v.position[1]));
     if (c < 0) continue;
     const std::size_t i = static_cast<std::size_t>(c);

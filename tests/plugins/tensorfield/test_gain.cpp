@@ -122,7 +122,8 @@ TEST(ViewGainSurface, TheViewsDistanceIsThatOfWhatItSeesAndAimPitchCentresTheBan
       if (cx > 1.0 && cx < 2.0)
         room.codes[static_cast<std::size_t>(room.geometry.Index(x, y))] = kFloorUnknown;
     }
-  const ViewChoice v = ViewGain(room.geometry, room.codes, Params(0.0)).Best({0, 0}, 0.0, 0.1);
+  const ViewChoice v =
+      ViewGain(room.geometry, room.codes, Params(0.0)).Best({0, 0}, 0.0, 0.1, true);
   ASSERT_GT(v.gain, 0.0);
   // Along the axis the strip spans t in [1, 2): ∫ t² / ∫ t = 2 (b³ - a³) / 3 (b² - a²); the
   // rays off the axis (up to 45°) meet it farther out, by up to 1 / cos 45°.
@@ -136,8 +137,9 @@ TEST(ViewGainSurface, TheViewsDistanceIsThatOfWhatItSeesAndAimPitchCentresTheBan
   EXPECT_GT(AimPitch(0.4, 1.0, 1.8), 0.0);  // a low arm camera looks up
   // Nothing seen: no distance.
   const Room known = MakeRoom(0.f, 0.f);
-  EXPECT_EQ(ViewGain(known.geometry, known.codes, Params(0.0)).Best({0, 0}, 0.0, kPi).distance_m,
-            0.0);
+  EXPECT_EQ(
+      ViewGain(known.geometry, known.codes, Params(0.0)).Best({0, 0}, 0.0, kPi, true).distance_m,
+      0.0);
 }
 
 }  // namespace
