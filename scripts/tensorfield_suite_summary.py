@@ -37,25 +37,52 @@ def load(out):
     return runs
 
 
-def census(run):
-    """Per key frame of a tensorfield run (plan_calls.csv diagnostics): degenerate points over
-    the normal- and the tangent-oriented vector fields' singularities, from the same constraints
-    (frames where the vector field has none are left out). Returns the two lists of ratios."""
-    ratios = {"normal": [], "tangent": []}
+def key_frames(run):
+    """The diagnostics of a run's key-frame calls (plan_calls.csv), as dicts of strings."""
     path = run["dir"] / "plan_calls.csv" if "dir" in run else None
     if path is None or not path.exists():
-        return ratios
+        return []
     with open(path, newline="") as f:
-        for row in csv.DictReader(f):
-            d = dict(kv.split("=", 1) for kv in row.get("diagnostics", "").split(";") if "=" in kv)
-            if "census_degenerate" not in d:
-                continue
-            points = float(d["census_degenerate"])
-            for kind in ratios:
-                singular = float(d.get(f"census_vector_{kind}", "0"))
-                if points >= 0 and singular > 0:
-                    ratios[kind].append(points / singular)
-    return ratios
+        rows = [dict(kv.split("=", 1) for kv in row.get("diagnostics", "").split(";") if "=" in kv)
+                for row in csv.DictReader(f)]
+    return [d for d in rows if "census_degenerate" in d]
+
+
+def census(frames):
+    """X Fig. 2 and 17 over one run's key frames: the degenerate points and the normal-oriented
+    vector field's singularities from the same constraints (census_vector; census_vector_normal
+    in runs before it), as medians per key frame and as the ratio of their sums (every key frame
+    counts, also those where the vector field has none); with topology control, the median over
+    key frames of the points after it over those before. None where a value is undefined."""
+    points, singular, control = [], [], []
+    for d in frames:
+        t = float(d["census_degenerate"])
+        n = float(d.get("census_vector", d.get("census_vector_normal", "-1")))
+        if t >= 0 and n >= 0:
+            points.append(t)
+            singular.append(n)
+        before, after = float(d.get("control_points_before", "-1")), float(d.get("control_points_after", "-1"))
+        if before > 0 and after >= 0:
+            control.append(after / before)
+    return {"key_frames": len(points),
+            "points": statistics.median(points) if points else None,
+            "singularities": statistics.median(singular) if singular else None,
+            "ratio": sum(points) / sum(singular) if sum(singular) > 0 else None,
+            "control": statistics.median(control) if control else None}
+
+
+def census_by_scene(runs):
+    """census() of every tensorfield run, by scene: medians over the scene's runs."""
+    out = {}
+    for scene in sorted({r["scene"] for r in runs if r["variant"] == "tensorfield"}):
+        per_run = [census(key_frames(r)) for r in runs
+                   if r["variant"] == "tensorfield" and r["scene"] == scene]
+        row = {"runs": len(per_run)}
+        for key in ("points", "singularities", "ratio"):
+            vals = [c[key] for c in per_run if c[key] is not None]
+            row[key] = statistics.median(vals) if vals else None
+        out[scene] = row
+    return out
 
 
 def medians(runs):
@@ -116,12 +143,16 @@ def targets(runs, med):
             lambda c: c["median"] <= 0.8 and c["below_1"] >= 0.8)
     t = paired(runs, "tensorfield", "linear", "base_ang_accel_radps2")
     add("space-time smoother than linear in >= 70 % of pairs", t, lambda c: c["below_1"] >= 0.7)
-    for kind in ("normal", "tangent"):
-        per_run = [statistics.median(r) for r in (census(run)[kind] for run in runs
-                                                   if run["variant"] == "tensorfield") if r]
-        comp = {"median": statistics.median(per_run), "pairs": len(per_run)} if per_run else None
-        add(f"degenerate points <= 0.5 x the {kind}-oriented vector field's singularities "
-            "(median over runs of the per-key-frame median)", comp, lambda c: c["median"] <= 0.5)
+    per_run = [c["ratio"] for c in (census(key_frames(r)) for r in runs if r["variant"] == "tensorfield")
+               if c["ratio"] is not None]
+    comp = {"median": statistics.median(per_run), "pairs": len(per_run)} if per_run else None
+    add("degenerate points <= 0.5 x the vector fields' singularities from the same constraints "
+        "(median over runs of each run's sum over its key frames)", comp, lambda c: c["median"] <= 0.5)
+    per_run = [c["control"] for c in (census(key_frames(r)) for r in runs if r["variant"] == "control")
+               if c["control"] is not None]
+    comp = {"median": statistics.median(per_run), "pairs": len(per_run)} if per_run else None
+    add("topology control: degenerate points after it <= 0.8 x before, per key frame (median over "
+        "runs of the per-key-frame median)", comp, lambda c: c["median"] <= 0.8)
     done = med.get("tensorfield", {}).get("done")
     rows.append({"target": ">= 90 % of tensorfield runs end done",
                  "status": "n/a" if done is None else ("met" if done >= 0.9 else "not met"),
@@ -137,7 +168,7 @@ def fmt(x, d=3):
     return "-" if x is None else (f"{x:.{d}f}" if isinstance(x, float) else str(x))
 
 
-def render(med, comps, tgts):
+def render(med, comps, tgts, fields=None):
     lines = ["## Medians per variant", "",
              "| variant | runs | done | " + " | ".join(label for _, label in METRICS) + " |",
              "|---" * (3 + len(METRICS)) + "|"]
@@ -150,6 +181,13 @@ def render(med, comps, tgts):
         if c:
             lines.append(f"| {v} | {key} | {c['pairs']} | {c['median']:.3f} | "
                          f"{c['ci95'][0]:.3f} - {c['ci95'][1]:.3f} | {c['below_1'] * 100:.0f} % |")
+    if fields:
+        lines += ["", "## Field census of the tensorfield runs (X Fig. 2; medians over the scene's runs)", "",
+                  "| scene | runs | degenerate points per key frame | vector singularities per key frame | "
+                  "ratio of sums |", "|---|---|---|---|---|"]
+        for scene, row in fields.items():
+            lines.append(f"| {scene} | {row['runs']} | {fmt(row['points'], 1)} | "
+                         f"{fmt(row['singularities'], 1)} | {fmt(row['ratio'], 2)} |")
     lines += ["", "## Targets (issue 31)", "", "| target | status | value |", "|---|---|---|"]
     for t in tgts:
         c = t["comparison"] or {}
@@ -163,10 +201,11 @@ def summarise(out):
     comps = {(v, key): paired(runs, "tensorfield", v, key)
              for v in med if v != "tensorfield" for key, _ in METRICS[:5]}
     tgts = targets(runs, med)
-    text = render(med, comps, tgts)
+    fields = census_by_scene(runs)
+    text = render(med, comps, tgts, fields)
     print(text)
     pathlib.Path(out, "summary.json").write_text(json.dumps(
-        {"runs": len(runs), "variants": med, "targets": tgts,
+        {"runs": len(runs), "variants": med, "targets": tgts, "census": fields,
          "comparisons": {f"{v}:{k}": c for (v, k), c in comps.items()}}, indent=2) + "\n")
     pathlib.Path(out, "summary.md").write_text(f"# tensorfield-suite summary: {out}\n\n" + text)
 
@@ -183,6 +222,14 @@ def self_test():
     assert parse_name("small-house-visual_tensorfield_s1") == ("small-house-visual", "tensorfield", "1")
     tg = targets(runs, medians(runs))
     assert tg[0]["status"] == "met", tg[0]
+    frames = [{"census_degenerate": "2", "census_vector": "0"},
+              {"census_degenerate": "4", "census_vector": "8", "control_points_before": "4",
+               "control_points_after": "2"},
+              {"census_degenerate": "3", "census_vector_normal": "4"}]  # an older run's name
+    c = census(frames)
+    assert c["key_frames"] == 3 and c["points"] == 3 and c["singularities"] == 4, c
+    assert abs(c["ratio"] - 9 / 12) < 1e-12 and c["control"] == 0.5, c
+    assert census([{"census_degenerate": "2", "census_vector": "0"}])["ratio"] is None
     print("self-test passed")
 
 

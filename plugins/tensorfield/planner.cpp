@@ -97,21 +97,13 @@ void RobotPlanner::BuildKeyFrame(const FloorInput& floor, const RobotInput& robo
   std::vector<BoundarySample> samples;
   TensorRaster next = WindowKeyFrame(window_, kp, options_.fill, &samples, options_.field);
   const double t1 = NowMs();
-  // The census of X Fig. 2 and 17 from the same constraints, before the fill: degenerate points
-  // of the paper's blend against the singularities of the normal- and tangent-oriented vector
-  // blends (diagnostics only; the planner drives the filled field).
+  // The census of X Fig. 2 from the same constraints (diagnostics only; the planner drives the
+  // filled field).
   {
-    const std::vector<std::uint8_t> domain = FieldDomain(window_.raster, kp.include_unknown);
-    const TensorRaster raw = BlendTensorField(window_.geometry, samples, domain, kp);
-    out->diag.census_degenerate = static_cast<int>(FindDegeneratePoints(raw).size());
-    out->diag.census_vector_normal =
-        static_cast<int>(FindVectorSingularities(BlendVectorField(window_.geometry, samples, domain,
-                                                                  VectorConstraint::kNormal, kp))
-                             .size());
-    out->diag.census_vector_tangent =
-        static_cast<int>(FindVectorSingularities(BlendVectorField(window_.geometry, samples, domain,
-                                                                  VectorConstraint::kTangent, kp))
-                             .size());
+    const FieldCensus census = CountFieldCensus(
+        window_.geometry, samples, FieldDomain(window_.raster, kp.include_unknown), kp);
+    out->diag.census_degenerate = census.degenerate_points;
+    out->diag.census_vector = census.vector_singularities;
   }
   const double t_control = NowMs();
   if (options_.topology_control && options_.field == FieldKind::kTensor) {
@@ -153,6 +145,9 @@ void RobotPlanner::BuildKeyFrame(const FloorInput& floor, const RobotInput& robo
     corner_wedges_ += moved.corner_wedges;
     retracted_wedges_ += moved.retracted_wedges;
     moved_trisectors_ += moved.moved_trisectors;
+    // X Fig. 17: the key frame's degenerate points before and after its control.
+    out->diag.control_points_before = static_cast<int>(points.size());
+    out->diag.control_points_after = static_cast<int>(FindDegeneratePoints(next, tp).size());
   }
   const double t_census = NowMs();
   frames_.clear();

@@ -161,9 +161,10 @@ struct StepDiagnostics {
   StepMode mode = StepMode::kNone;
   int stop = -1;  // AdvectionStop of this call's pathline, -1 when none was advected
   int settled_goals = 0;
-  // Key-frame calls only (-1 otherwise): the same constraints' degenerate points (the paper's
-  // blend, unfilled) and the normal- and tangent-oriented vector fields' singularities.
-  int census_degenerate = -1, census_vector_normal = -1, census_vector_tangent = -1;
+  // Key-frame calls only (-1 otherwise): CountFieldCensus of the key frame's constraints; with
+  // topology_control, the key frame's degenerate points before and after it.
+  int census_degenerate = -1, census_vector = -1;
+  int control_points_before = -1, control_points_after = -1;
   double census_ms = -1.0;
   double control_ms = -1.0;  // key-frame calls: topology control (0 when off)
   // X12 (this call): camera samples with a look-at target, those whose selected view sees it,

@@ -220,8 +220,11 @@ class TensorfieldPlanner : public vp::Planner {
       out.Diagnostic("census_ms" + s, d.census_ms);
       if (options_.topology_control) out.Diagnostic("control_ms" + s, d.control_ms);
       out.Diagnostic("census_degenerate" + s, d.census_degenerate);
-      out.Diagnostic("census_vector_normal" + s, d.census_vector_normal);
-      out.Diagnostic("census_vector_tangent" + s, d.census_vector_tangent);
+      out.Diagnostic("census_vector" + s, d.census_vector);
+      if (options_.topology_control) {
+        out.Diagnostic("control_points_before" + s, d.control_points_before);
+        out.Diagnostic("control_points_after" + s, d.control_points_after);
+      }
     }
     out.Diagnostic("keyframe" + s, d.keyframe ? 1.0 : 0.0);
     out.Diagnostic("topology_ms" + s, d.topology_ms);

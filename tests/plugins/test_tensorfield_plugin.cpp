@@ -278,12 +278,20 @@ TEST(Tensorfield, TopologyControlReportsItsWorkAndKeepsThePathInFreeSpace) {
     last_total = total;
     if (Diagnostic(r, "keyframe") == 1.0) {
       EXPECT_GE(Diagnostic(r, "control_ms"), 0.0);
+      // Cancellations remove points, moves keep their count: never more after than before.
+      const double before = Diagnostic(r, "control_points_before");
+      EXPECT_GE(before, 0.0);
+      EXPECT_GE(Diagnostic(r, "control_points_after"), 0.0);
+      EXPECT_LE(Diagnostic(r, "control_points_after"), before);
+      EXPECT_GE(Diagnostic(r, "census_degenerate"), 1.0);
+      EXPECT_GE(Diagnostic(r, "census_vector"), 0.0);
     }
     for (const PathPoint& p : r.robots[0].path)
       EXPECT_TRUE(Traversable(world, p.position_m, 0.18f)) << p.position_m.transpose();
     const PlanResult q = MustPlan(*plain, world, At(5.0 + 0.4 * call));
     EXPECT_TRUE(std::isnan(Diagnostic(q, "corner_wedges")));
     EXPECT_TRUE(std::isnan(Diagnostic(q, "control_ms")));
+    EXPECT_TRUE(std::isnan(Diagnostic(q, "control_points_before")));
   }
 }
 

@@ -270,4 +270,18 @@ struct VectorSingularity {
 std::vector<VectorSingularity> FindVectorSingularities(const VectorRaster& field,
                                                        const TopologyParams& params = {});
 
+// X Fig. 2's census from one key frame's constraints: the tensor blend's degenerate points and the
+// normal-oriented vector blend's singularities (the tangent-oriented one is that field turned by
+// -90° everywhere, so its count is the same). Both blends run to 6σ instead of params'
+// truncation and without the flat-region rule, so that a room's interior is counted: at 3σ a room
+// centre more than 1.5 m from every wall is exactly zero, and a convex room's one sink of the
+// normal field lies there (against the tensor field's two wedges, index +1/2 each).
+struct FieldCensus {
+  int degenerate_points = 0;
+  int vector_singularities = 0;
+};
+FieldCensus CountFieldCensus(const omt::RasterGeometry& geometry,
+                             std::span<const BoundarySample> samples,
+                             std::span<const std::uint8_t> domain, const KeyFrameParams& params);
+
 }  // namespace voxplan::tensorfield

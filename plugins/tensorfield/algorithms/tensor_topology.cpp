@@ -240,4 +240,25 @@ std::vector<VectorSingularity> FindVectorSingularities(const VectorRaster& field
   return out;
 }
 
+FieldCensus CountFieldCensus(const omt::RasterGeometry& geometry,
+                             std::span<const BoundarySample> samples,
+                             std::span<const std::uint8_t> domain, const KeyFrameParams& params) {
+  // e^-36 ≈ 2e-16 of a basis field at 6σ: below PerturbedAngles' ε (1e-9 of the largest
+  // magnitude), so the tails beyond would not turn an angle.
+  constexpr double kCensusSigmas = 6.0;
+  KeyFrameParams p = params;
+  p.truncation_sigmas = std::max(p.truncation_sigmas, kCensusSigmas);
+  TopologyParams tp;
+  tp.min_relative_magnitude = 0.0;  // no solver noise in a blend; ε alone decides flat loops
+  tp.refine_position = false;       // counts only
+  FieldCensus census;
+  census.degenerate_points = static_cast<int>(
+      FindDegeneratePoints(BlendTensorField(geometry, samples, domain, p), tp).size());
+  census.vector_singularities = static_cast<int>(
+      FindVectorSingularities(
+          BlendVectorField(geometry, samples, domain, VectorConstraint::kNormal, p), tp)
+          .size());
+  return census;
+}
+
 }  // namespace voxplan::tensorfield
