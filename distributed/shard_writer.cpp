@@ -52,6 +52,15 @@ Result<ShardManifest> WriteShardedMap(Communicator& comm, const TsdfVolume& loca
       for (const ShardManifest::Shard& s : previous->shards) remove(s);
     }
   }
+  // And those no manifest names: a killed run's half-written generation (its ranks wrote their
+  // shards, the manifest never came), which a resume would otherwise leave for ever. The other
+  // ranks wait, so none writes its next generation's shard while the folder is swept.
+  if (comm.is_root())
+    for (const std::string& stale : StaleShardFiles(path, m)) {
+      std::error_code ec;
+      std::filesystem::remove(ShardFilePath(path, stale), ec);  // already gone: no error
+    }
+  VOXPLAN_RETURN_IF_ERROR(AgreeOnStatus(comm, Status::Ok()));
   return m;
 }
 

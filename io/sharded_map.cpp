@@ -1,5 +1,6 @@
 #include "io/sharded_map.h"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <cstring>
@@ -43,6 +44,47 @@ std::string ShardFilePath(const std::string& manifest, const std::string& name) 
 bool SafeShardName(const std::string& name) {
   return !name.empty() && name.size() < 256 && name.find('/') == std::string::npos &&
          name.find('\\') == std::string::npos && name[0] != '.';
+}
+
+namespace {
+
+// Consumes one or more decimal digits at `at`.
+bool SkipDigits(const std::string& s, size_t& at) {
+  const size_t from = at;
+  while (at < s.size() && s[at] >= '0' && s[at] <= '9') ++at;
+  return at > from;
+}
+
+// Whether `name` is `<prefix>g<digits>.r<digits>-of-<digits>.vpmap`, as ShardFileName writes.
+bool IsShardFileName(const std::string& name, const std::string& prefix) {
+  if (name.rfind(prefix, 0) != 0) return false;
+  size_t at = prefix.size();
+  const auto skip = [&](const char* text) {
+    const size_t n = std::strlen(text);
+    if (name.compare(at, n, text) != 0) return false;
+    at += n;
+    return true;
+  };
+  return skip("g") && SkipDigits(name, at) && skip(".r") && SkipDigits(name, at) && skip("-of-") &&
+         SkipDigits(name, at) && skip(".vpmap") && at == name.size();
+}
+
+}  // namespace
+
+std::vector<std::string> StaleShardFiles(const std::string& manifest,
+                                         const ShardManifest& current) {
+  const std::string prefix = fs::path(manifest).filename().string() + ".";
+  std::vector<std::string> stale;
+  std::error_code ec;
+  for (fs::directory_iterator it(Folder(manifest), ec), end; !ec && it != end; it.increment(ec)) {
+    const std::string name = it->path().filename().string();
+    if (!IsShardFileName(name, prefix)) continue;
+    bool named = false;
+    for (const ShardManifest::Shard& s : current.shards) named = named || s.file == name;
+    if (!named) stale.push_back(name);
+  }
+  std::sort(stale.begin(), stale.end());
+  return stale;
 }
 
 std::string ShardManifestText(const ShardManifest& m) {

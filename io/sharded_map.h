@@ -6,7 +6,8 @@
 // checksums, the owner function (core/shard.h) and what the writer needs to resume (a fuse run's
 // frame cursor and report so far). Shards of a new generation never replace the ones the current
 // manifest names, so a run killed at any point leaves a manifest and the shards it names; the
-// previous generation's shards are removed only after the new manifest is in place.
+// previous generation's shards, and any a killed run wrote without a manifest, are removed only
+// after the new manifest is in place.
 // Readers (`voxplan mesh`, `info`, `render`) load every shard into one volume whatever the rank
 // count (LoadAnyMap); a sharded run can keep only the blocks it owns under another rank count.
 // Written by distributed/shard_writer.h; read here, in io, so every reader of maps can.
@@ -54,6 +55,10 @@ std::string ShardFileName(const std::string& manifest, uint64_t generation, int 
 std::string ShardFilePath(const std::string& manifest, const std::string& name);
 std::string ShardManifestText(const ShardManifest& manifest);
 bool SafeShardName(const std::string& name);
+// The shard files beside `manifest` (names of the form above, for its file name) that `current`
+// does not name, sorted: a killed run's half-written generation, or a replaced one's. Empty when
+// the folder cannot be listed.
+std::vector<std::string> StaleShardFiles(const std::string& manifest, const ShardManifest& current);
 
 // Loads the blocks `keep` owns (all by default) from every shard the manifest names, checking
 // each shard's block count and checksum against the manifest.

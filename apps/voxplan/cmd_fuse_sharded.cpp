@@ -170,10 +170,11 @@ int RunFuseSharded(const FuseOptions& o, Communicator& comm) {
       s = m.ok() ? Status::Ok() : m.status();
     } else {
       s = SaveMap(local, o.map_path, up).Naming(o.map_path);
-      if (s.ok() && previous)
-        for (const ShardManifest::Shard& shard : previous->shards) {
+      // The plain map names no shard: the checkpoint's go, and any a killed run left.
+      if (s.ok())
+        for (const std::string& stale : StaleShardFiles(o.map_path, ShardManifest{})) {
           std::error_code ec;
-          std::filesystem::remove(ShardFilePath(o.map_path, shard.file), ec);
+          std::filesystem::remove(ShardFilePath(o.map_path, stale), ec);
         }
     }
     if (!s.ok()) return FailOnRank(comm, s);

@@ -288,6 +288,25 @@ TEST(ShardedMap, WritesReadsAndChecksItsShards) {
   EXPECT_FALSE(fs::exists(dir / m->shards[0].file));
   EXPECT_TRUE(fs::exists(dir / next->shards[0].file));
 
+  // A killed run's half-written generation (shards, no manifest) goes with the next one; files
+  // that only look like shards, or are another map's, stay.
+  const std::vector<std::string> orphans = {"m.vpmap.g10.r0-of-3.vpmap",
+                                            "m.vpmap.g10.r2-of-3.vpmap"};
+  const std::vector<std::string> others = {"m.vpmap.g10.r1-of-3.vpmap.bak",
+                                           "m.vpmap.gx.r0-of-1.vpmap", "m.vpmap.g10.r1-of-.vpmap",
+                                           "n.vpmap.g10.r0-of-1.vpmap"};
+  for (const std::string& name : orphans) std::ofstream(dir / name) << "x";
+  for (const std::string& name : others) std::ofstream(dir / name) << "x";
+  EXPECT_EQ(StaleShardFiles(path, *next), orphans);
+  Result<ShardManifest> third = WriteShardedMap(comm, whole, path, 11, true, {}, &*next);
+  ASSERT_TRUE(third.ok());
+  EXPECT_TRUE(StaleShardFiles(path, *third).empty());
+  for (const std::string& name : orphans) EXPECT_FALSE(fs::exists(dir / name)) << name;
+  for (const std::string& name : others) EXPECT_TRUE(fs::exists(dir / name)) << name;
+  EXPECT_FALSE(fs::exists(dir / next->shards[0].file));
+  ASSERT_TRUE(LoadAnyMap(path).ok());
+  next = std::move(third);
+
   // Broken manifests are refused with the file's name and the reason.
   const std::string text = ReadFile(path);
   const auto refused = [&](const std::string& from, const std::string& to, const std::string& why) {
