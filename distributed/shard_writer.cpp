@@ -1,7 +1,6 @@
 #include "distributed/shard_writer.h"
 
 #include <cstring>
-#include <filesystem>
 
 #include "io/file_util.h"
 #include "io/map_io.h"
@@ -10,8 +9,7 @@ namespace voxplan {
 
 Result<ShardManifest> WriteShardedMap(Communicator& comm, const TsdfVolume& local,
                                       const std::string& path, uint64_t generation, bool complete,
-                                      const nlohmann::json& run, const ShardManifest* previous,
-                                      WorldUp up) {
+                                      const nlohmann::json& run, WorldUp up) {
   const std::string name = ShardFileName(path, generation, comm.rank(), comm.size());
   const Status mine = SaveMap(local, ShardFilePath(path, name), up);
   VOXPLAN_RETURN_IF_ERROR(AgreeOnStatus(comm, mine));
@@ -38,28 +36,10 @@ Result<ShardManifest> WriteShardedMap(Communicator& comm, const TsdfVolume& loca
   if (comm.is_root()) written = WriteFileAtomically(path, ShardManifestText(m)).Naming(path);
   VOXPLAN_RETURN_IF_ERROR(AgreeOnStatus(comm, written));
 
-  // The new manifest is in place: the shards the previous one named can go.
-  if (previous) {
-    const auto remove = [&](const ShardManifest::Shard& s) {
-      if (s.file == name || !SafeShardName(s.file)) return;
-      std::error_code ec;
-      std::filesystem::remove(ShardFilePath(path, s.file), ec);  // already gone: no error
-    };
-    if (previous->ranks == m.ranks) {
-      if (size_t(comm.rank()) < previous->shards.size())
-        remove(previous->shards[size_t(comm.rank())]);
-    } else if (comm.is_root()) {
-      for (const ShardManifest::Shard& s : previous->shards) remove(s);
-    }
-  }
-  // And those no manifest names: a killed run's half-written generation (its ranks wrote their
-  // shards, the manifest never came), which a resume would otherwise leave for ever. The other
-  // ranks wait, so none writes its next generation's shard while the folder is swept.
-  if (comm.is_root())
-    for (const std::string& stale : StaleShardFiles(path, m)) {
-      std::error_code ec;
-      std::filesystem::remove(ShardFilePath(path, stale), ec);  // already gone: no error
-    }
+  // The new manifest is in place: every shard of this map it does not name can go, the previous
+  // generation's and any a killed run wrote without a manifest. The other ranks wait, so none
+  // writes its next generation's shard while the folder is swept.
+  if (comm.is_root()) RemoveStaleShards(path, m);
   VOXPLAN_RETURN_IF_ERROR(AgreeOnStatus(comm, Status::Ok()));
   return m;
 }

@@ -11,14 +11,12 @@
 namespace voxplan {
 
 // Collective. Writes this rank's blocks as its shard of generation `generation`, then (rank 0)
-// the manifest, then removes the shards `previous` named (each rank its own; rank 0 all of them
-// when the rank count changed). Every rank gets the same status, and the new manifest (its
-// shard names; checksums on rank 0 only). `up`: the world's up axis, in the manifest and the
-// shards.
+// the manifest, then (rank 0) every shard of this map the manifest does not name: the previous
+// generation's, and a killed run's half-written one (RemoveStaleShards). Every rank gets the same
+// status, and the new manifest (its shard names; checksums on rank 0 only). `up`: the world's up
+// axis, in the manifest and the shards.
 Result<ShardManifest> WriteShardedMap(Communicator& comm, const TsdfVolume& local,
                                       const std::string& path, uint64_t generation, bool complete,
-                                      const nlohmann::json& run,
-                                      const ShardManifest* previous = nullptr,
-                                      WorldUp up = WorldUp::kUnknown);
+                                      const nlohmann::json& run, WorldUp up = WorldUp::kUnknown);
 
 }  // namespace voxplan

@@ -396,14 +396,6 @@ Result<ShardedFuseReport> FuseDatasetSharded(Communicator& comm, const Dataset* 
     loaded->ForEachBlock(
         [&](BlockIndex b, const TsdfBlock& block) { local.FindOrAllocate(b) = block; });
     out.frames_resumed = start;
-    out.checkpoint = std::move(manifest);
-  }
-
-  if (!params.resume && !params.checkpoint_path.empty() &&
-      IsShardedMapFile(params.checkpoint_path)) {
-    // A new run over an old sharded map: its shards go once this run's first manifest is in.
-    if (Result<ShardManifest> old = ReadShardManifest(params.checkpoint_path); old.ok())
-      out.checkpoint = std::move(*old);
   }
   FuseParams fuse = params.fuse;
   fuse.integrate.shard = {uint32_t(comm.rank()), uint32_t(comm.size())};
@@ -444,11 +436,8 @@ Result<ShardedFuseReport> FuseDatasetSharded(Communicator& comm, const Dataset* 
       merged.frames_selected = total_done;  // so far: the frames done, not the run's selection
       Result<ShardManifest> written =
           WriteShardedMap(comm, local, params.checkpoint_path, total_done, /*complete=*/false,
-                          CheckpointRun(params, total_done, merged),
-                          out.checkpoint ? &*out.checkpoint : nullptr, info.up);
-      if (!written.ok()) return written.status();
-      out.checkpoint = std::move(*written);
-      return Status::Ok();
+                          CheckpointRun(params, total_done, merged), info.up);
+      return written.ok() ? Status::Ok() : written.status();
     };
   }
   const RelayedDataset relayed(info);

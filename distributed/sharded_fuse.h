@@ -8,7 +8,6 @@
 // the run's frame cursor; a resumed run continues from the last one, under any rank count.
 // The same code runs in one process with a SerialCommunicator (checkpoints and resume there too).
 #include <nlohmann/json.hpp>
-#include <optional>
 #include <string>
 #include <vector>
 
@@ -43,11 +42,8 @@ struct ShardedFuseParams {
 };
 
 struct ShardedFuseReport {
-  FuseReport report;          // the whole run, resumed frames included (on every rank)
-  size_t frames_resumed = 0;  // selected frames a checkpoint had done before this run
-  // The last checkpoint written or resumed from, else the sharded map the run replaces at its
-  // path (its shards are removed once the run's own manifest is in place).
-  std::optional<ShardManifest> checkpoint;
+  FuseReport report;                 // the whole run, resumed frames included (on every rank)
+  size_t frames_resumed = 0;         // selected frames a checkpoint had done before this run
   uint64_t broadcast_bytes = 0;      // frames sent by rank 0, in all
   std::vector<double> broadcast_ms;  // per selected frame: its broadcast
 };

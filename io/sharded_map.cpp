@@ -87,6 +87,13 @@ std::vector<std::string> StaleShardFiles(const std::string& manifest,
   return stale;
 }
 
+void RemoveStaleShards(const std::string& manifest, const ShardManifest& current) {
+  for (const std::string& stale : StaleShardFiles(manifest, current)) {
+    std::error_code ec;
+    fs::remove(ShardFilePath(manifest, stale), ec);  // already gone: no error
+  }
+}
+
 std::string ShardManifestText(const ShardManifest& m) {
   nlohmann::json j;
   j["format"] = kShardedMapFormat;

@@ -59,6 +59,8 @@ bool SafeShardName(const std::string& name);
 // does not name, sorted: a killed run's half-written generation, or a replaced one's. Empty when
 // the folder cannot be listed.
 std::vector<std::string> StaleShardFiles(const std::string& manifest, const ShardManifest& current);
+// Removes them (once `current` is in place at `manifest`, or a plain map that names none).
+void RemoveStaleShards(const std::string& manifest, const ShardManifest& current);
 
 // Loads the blocks `keep` owns (all by default) from every shard the manifest names, checking
 // each shard's block count and checksum against the manifest.

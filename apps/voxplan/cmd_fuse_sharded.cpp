@@ -3,6 +3,7 @@
 // as for the one-process run, the same on every rank (the others print nothing but their own
 // warnings, prefixed with their rank).
 #include <iostream>
+#include <optional>
 
 #include "apps/voxplan/cmd_fuse.h"
 #include "apps/voxplan/progress.h"
@@ -163,19 +164,14 @@ int RunFuseSharded(const FuseOptions& o, Communicator& comm) {
     Status s = Status::Ok();
     const uint64_t generation = uint64_t(indices.size());
     const nlohmann::json run = CheckpointRun(params, indices.size(), report);
-    const ShardManifest* previous = fused->checkpoint ? &*fused->checkpoint : nullptr;
     if (split) {
       Result<ShardManifest> m = WriteShardedMap(comm, local, o.map_path, generation,
-                                                /*complete=*/true, run, previous, up);
+                                                /*complete=*/true, run, up);
       s = m.ok() ? Status::Ok() : m.status();
     } else {
       s = SaveMap(local, o.map_path, up).Naming(o.map_path);
       // The plain map names no shard: the checkpoint's go, and any a killed run left.
-      if (s.ok())
-        for (const std::string& stale : StaleShardFiles(o.map_path, ShardManifest{})) {
-          std::error_code ec;
-          std::filesystem::remove(ShardFilePath(o.map_path, stale), ec);
-        }
+      if (s.ok()) RemoveStaleShards(o.map_path, ShardManifest{});
     }
     if (!s.ok()) return FailOnRank(comm, s);
   }

@@ -283,7 +283,7 @@ TEST(ShardedMap, WritesReadsAndChecksItsShards) {
   EXPECT_LT(part->num_blocks(), whole.num_blocks());
 
   // A new generation replaces the old shard only once its manifest is in place.
-  Result<ShardManifest> next = WriteShardedMap(comm, whole, path, 9, true, {}, &*m);
+  Result<ShardManifest> next = WriteShardedMap(comm, whole, path, 9, true, {});
   ASSERT_TRUE(next.ok());
   EXPECT_FALSE(fs::exists(dir / m->shards[0].file));
   EXPECT_TRUE(fs::exists(dir / next->shards[0].file));
@@ -298,7 +298,7 @@ TEST(ShardedMap, WritesReadsAndChecksItsShards) {
   for (const std::string& name : orphans) std::ofstream(dir / name) << "x";
   for (const std::string& name : others) std::ofstream(dir / name) << "x";
   EXPECT_EQ(StaleShardFiles(path, *next), orphans);
-  Result<ShardManifest> third = WriteShardedMap(comm, whole, path, 11, true, {}, &*next);
+  Result<ShardManifest> third = WriteShardedMap(comm, whole, path, 11, true, {});
   ASSERT_TRUE(third.ok());
   EXPECT_TRUE(StaleShardFiles(path, *third).empty());
   for (const std::string& name : orphans) EXPECT_FALSE(fs::exists(dir / name)) << name;
