@@ -44,4 +44,13 @@ Result<ShardManifest> WriteShardedMap(Communicator& comm, const TsdfVolume& loca
   return m;
 }
 
+Status WriteFinalMap(Communicator& comm, const TsdfVolume& local, const std::string& path,
+                     uint64_t generation, const nlohmann::json& run, WorldUp up) {
+  if (comm.size() > 1)
+    return WriteShardedMap(comm, local, path, generation, /*complete=*/true, run, up).status();
+  VOXPLAN_RETURN_IF_ERROR(SaveMap(local, path, up).Naming(path));
+  RemoveStaleShards(path, ShardManifest{});  // the plain map names no shard
+  return Status::Ok();
+}
+
 }  // namespace voxplan

@@ -19,4 +19,10 @@ Result<ShardManifest> WriteShardedMap(Communicator& comm, const TsdfVolume& loca
                                       const std::string& path, uint64_t generation, bool complete,
                                       const nlohmann::json& run, WorldUp up = WorldUp::kUnknown);
 
+// Collective. A run's final map at `path`: split over ranks, the complete sharded map of
+// generation `generation` (WriteShardedMap); in one process a plain map, after which every shard
+// of this name goes (a checkpoint's, a killed run's). Every rank gets the same status.
+Status WriteFinalMap(Communicator& comm, const TsdfVolume& local, const std::string& path,
+                     uint64_t generation, const nlohmann::json& run, WorldUp up);
+
 }  // namespace voxplan

@@ -13,9 +13,7 @@
 #include "core/summary.h"
 #include "distributed/sharded_fuse.h"
 #include "io/file_util.h"
-#include "io/map_io.h"
 #include "io/output_transaction.h"
-#include "io/sharded_map.h"
 #include "pipeline/fuse_outputs.h"
 
 namespace voxplan::cli {
@@ -157,22 +155,12 @@ int RunFuseSharded(const FuseOptions& o, Communicator& comm) {
   }
 
   // The map: split, a sharded map (the final generation, complete); in one process a plain map
-  // replacing the checkpoint, whose shards then go.
+  // replacing the checkpoint.
   const Stopwatch write_clock;
   const WorldUp up = FusedWorldUp(info, report, /*tracked=*/false);
   if (!o.map_path.empty()) {
-    Status s = Status::Ok();
-    const uint64_t generation = uint64_t(indices.size());
-    const nlohmann::json run = CheckpointRun(params, indices.size(), report);
-    if (split) {
-      Result<ShardManifest> m = WriteShardedMap(comm, local, o.map_path, generation,
-                                                /*complete=*/true, run, up);
-      s = m.ok() ? Status::Ok() : m.status();
-    } else {
-      s = SaveMap(local, o.map_path, up).Naming(o.map_path);
-      // The plain map names no shard: the checkpoint's go, and any a killed run left.
-      if (s.ok()) RemoveStaleShards(o.map_path, ShardManifest{});
-    }
+    const Status s = WriteFinalMap(comm, local, o.map_path, uint64_t(indices.size()),
+                                   CheckpointRun(params, indices.size(), report), up);
     if (!s.ok()) return FailOnRank(comm, s);
   }
   Mesh mesh;
