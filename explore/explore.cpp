@@ -165,10 +165,11 @@ class Explorer {
   Status StepToView(RobotRun& r, QueuedTask& q);
   bool RouteTo(RobotRun& r, const QueuedTask& q);
   void Fail(RobotRun& r, const std::string& why);
-  // Tracked poses: where frame `frame` of r is fused, or nullopt when the tracker lost it.
+  // Tracked poses: where frame `frame` of r is fused, or nullopt when the tracker lost it;
+  // *odometry: fused at the odometry prior (ExploreParams::odometry_without_model).
   Result<std::optional<Pose3f>> TrackFrame(RobotRun& r, const RenderOutput& frame,
                                            const PinholeCamera& camera, const Pose3f& T_W_C,
-                                           float* residual_rms_m);
+                                           float* residual_rms_m, bool* odometry);
   void Bump(RobotRun& r, const Eigen::Vector2f& goal_W);
   // A drive the true floor refused on the way to q: a plugin path is left for the host's route,
   // the host's own route bumps and fails the task.
@@ -266,9 +267,11 @@ Status Explorer::Fuse(RobotRun& r, bool force) {
   }
   Pose3f T_fuse = T_W_C;
   float residual_rms_m = 0.f;
+  bool odometry = false;
   if (p_.poses == ExploreParams::Poses::kTracked) {
     t0 = NowMs();
-    Result<std::optional<Pose3f>> tracked = TrackFrame(r, out, camera, T_W_C, &residual_rms_m);
+    Result<std::optional<Pose3f>> tracked =
+        TrackFrame(r, out, camera, T_W_C, &residual_rms_m, &odometry);
     result_.timings.track_ms += NowMs() - t0;
     if (!tracked.ok()) return tracked.status();
     if (!tracked->has_value()) {  // lost: not fused (a wrong pose would smear the map)
@@ -277,6 +280,7 @@ Status Explorer::Fuse(RobotRun& r, bool force) {
       return Status::Ok();
     }
     T_fuse = **tracked;
+    if (odometry) ++result_.frames_odometry;
   }
   IntegrateParams ip;
   ip.min_depth_m = r.robot.mode_params().min_range_m;
@@ -302,13 +306,13 @@ Status Explorer::Fuse(RobotRun& r, bool force) {
                   stats->integrate.touched_blocks.end());
   ++r.frames;
   ++result_.frames_fused;
-  result_.frames[r.index].push_back({r.t_s, T_W_C, T_fuse, residual_rms_m});
+  result_.frames[r.index].push_back({r.t_s, T_W_C, T_fuse, residual_rms_m, odometry});
   return Status::Ok();
 }
 
 Result<std::optional<Pose3f>> Explorer::TrackFrame(RobotRun& r, const RenderOutput& frame,
                                                    const PinholeCamera& camera, const Pose3f& T_W_C,
-                                                   float* residual_rms_m) {
+                                                   float* residual_rms_m, bool* odometry) {
   if (!r.tracking_started) {  // the start sweep anchors the map where the robot truly is
     r.last_true_T_W_C = r.last_fused_T_W_C = T_W_C;
     return std::optional<Pose3f>(T_W_C);
@@ -333,6 +337,15 @@ Result<std::optional<Pose3f>> Explorer::TrackFrame(RobotRun& r, const RenderOutp
   if (!t.ok()) return t.status();
   r.last_true_T_W_C = T_W_C;
   *residual_rms_m = t->residual_rms_m;
+  if (!t->ok && t->no_model && p_.odometry_without_model) {
+    // Nothing in view to register against (the camera looks into space the map does not hold
+    // yet): the odometry is the best pose there is, and skipping the frame would keep the map
+    // from ever growing there, so every later frame would see no model either.
+    *odometry = true;
+    r.last_fused_T_W_C = prior;
+    it->second->Accept(prior);
+    return std::optional<Pose3f>(prior);
+  }
   if (!t->ok) {  // dead reckoning carries on from the prior
     r.last_fused_T_W_C = prior;
     return std::optional<Pose3f>();
@@ -1280,7 +1293,8 @@ TrackedPoseSummary SummarizeTrackedPoses(const std::vector<std::vector<ExploreFr
       const ExploreFrame& f = robot[i];
       squared += (f.T_W_C_fused.translation() - f.T_W_C.translation()).squaredNorm();
       ++out.frames;
-      if (f.residual_rms_m > 0.f) residuals.push_back(f.residual_rms_m);  // tracked, not anchored
+      // Registered frames only: the sweep's are anchored, the odometry's had nothing to register.
+      if (!f.odometry && f.residual_rms_m > 0.f) residuals.push_back(f.residual_rms_m);
     }
   }
   const TimingSummary r = Summarize(residuals);

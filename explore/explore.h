@@ -81,6 +81,12 @@ struct ExploreParams {
     t.min_inlier_ratio = 0.1f;
     return t;
   }();
+  // A frame in which the map shows no surface to register against (TrackingResult::no_model) is
+  // fused at the odometry prior instead of skipped: skipped, the map would never grow where the
+  // camera looks, and every later frame there would see no model either (a room beyond the start
+  // sweep's range stayed unmapped for the rest of the run). Frames whose registration failed on
+  // a surface the map does hold are still skipped.
+  bool odometry_without_model = true;
   bool fuse_labels = true;  // instance labels into the object map
   // How the labels are detected before they are fused (sim/detector.h): noisy by default.
   DetectorParams detector;
@@ -169,6 +175,7 @@ struct ExploreFrame {
   Pose3f T_W_C = Pose3f::Identity();
   Pose3f T_W_C_fused = Pose3f::Identity();  // where it was fused (the estimate when tracked)
   float residual_rms_m = 0.f;               // the tracker's, when tracked
+  bool odometry = false;  // tracked poses: fused at the odometry prior (no model in view)
 };
 
 struct ExploreResult {
@@ -177,6 +184,7 @@ struct ExploreResult {
   double time_s = 0.0;
   size_t frames_fused = 0;
   size_t frames_lost = 0;       // with tracked poses: frames the tracker lost, not fused
+  size_t frames_odometry = 0;   // with tracked poses: fused at the odometry prior (no model)
   size_t objects_detected = 0;  // summed over frames, after the detector's noise
   size_t failed_tasks = 0;
   size_t rejected_tasks = 0;

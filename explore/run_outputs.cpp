@@ -91,6 +91,7 @@ json MetricsObject(const ExploreRunParams& params, const ExploreRunReport& repor
     const TrackedPoseSummary t = SummarizeTrackedPoses(r.frames);
     m["poses"] = "tracked";
     m["frames_lost"] = r.frames_lost;
+    m["frames_odometry"] = r.frames_odometry;
     m["registration_rms_m"] = RoundTo(t.residual_mean_m, 5);
     m["registration_rms_p90_m"] = RoundTo(t.residual_p90_m, 5);
     m["ate_rms_m"] = RoundTo(t.ate_rms_m, 5);

@@ -243,6 +243,7 @@ struct NormalEquations {
   Eigen::Vector3d sum_p_W = Eigen::Vector3d::Zero();  // of the inliers, for the conditioning
   double sum_p_W2 = 0.0;
   size_t inliers = 0;
+  size_t model_hits = 0;  // input points that land on a model pixel with a surface
   size_t photometric = 0;
 };
 
@@ -296,6 +297,7 @@ struct ChunkSums {
   double r2 = 0.0;
   double p[4] = {};
   size_t inliers = 0;
+  size_t model_hits = 0;
   size_t photometric = 0;
 
   void Add(TermBatch& batch) {
@@ -309,6 +311,7 @@ struct ChunkSums {
     r2 += c.r2;
     for (int k = 0; k < 4; ++k) p[k] += c.p[k];
     inliers += c.inliers;
+    model_hits += c.model_hits;
     photometric += c.photometric;
   }
 };
@@ -382,6 +385,7 @@ NormalEquations BuildSystem(const InputLevel& in, const ModelImages& model, cons
           const int mu = int(x + 0.5f), mv = int(y + 0.5f);
           const Eigen::Vector3f& q_W = model.raycast.vertex_W.at(mu, mv);
           if (!std::isfinite(q_W.x())) continue;
+          ++sums.model_hits;
           const Eigen::Vector3f p_W = R_W_C * pt.p_C + t_W_C;
           const Eigen::Vector3f diff = p_W - q_W;
           if (diff.squaredNorm() > max_dist2) continue;
@@ -426,6 +430,7 @@ NormalEquations BuildSystem(const InputLevel& in, const ModelImages& model, cons
   ne.sum_p_W = Eigen::Vector3d(total.p[0], total.p[1], total.p[2]);
   ne.sum_p_W2 = total.p[3];
   ne.inliers = total.inliers;
+  ne.model_hits = total.model_hits;
   ne.photometric = total.photometric;
   return ne;
 }
@@ -580,6 +585,7 @@ Result<TrackingResult> FrameTracker::Track(const DepthImage& depth, const ColorI
       ++result.level_iterations[size_t(l)];
       if (last.inliers < kMinCorrespondences) {
         result.icp_ms = clock.ElapsedMs();
+        result.no_model = last.model_hits < kMinCorrespondences;
         return finish("too few correspondences with the model (" + std::to_string(last.inliers) +
                       " at level " + std::to_string(l) + ")");
       }

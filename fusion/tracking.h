@@ -58,6 +58,9 @@ struct TrackingResult {
   bool ok = false;
   Pose3f T_W_C = Pose3f::Identity();  // estimate (the prediction when !ok)
   float inlier_ratio = 0.f;
+  // Lost because the model shows (almost) no surface in view: nothing to register against, as
+  // opposed to a surface the frame does not align with.
+  bool no_model = false;
   float residual_rms_m = 0.f;
   float condition_number = 0.f;
   int iterations = 0;                               // Gauss-Newton steps over all levels

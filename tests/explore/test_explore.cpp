@@ -557,37 +557,51 @@ TEST(Explore, RequestedCallsComeAtTheFirstStepAfterTheirTime) {
   for (const PlanCallRecord& c : refused->plan_calls) EXPECT_NE(c.event, PlanEvent::kWakeup);
 }
 
-TEST(Explore, TrackedPosesFuseAtTheEstimateAndCountLostFrames) {
-  // --poses tracked: the start sweep is fused at the truth, every later frame at the tracker's
-  // estimate (close to the truth, not equal) or not at all (lost, counted); at the truth every
-  // frame is fused where it was taken.
-  const Scene& s = SmallApartment();
-  // The loop's own map and image size (FastParams' 10 cm and 160 x 120 are too coarse to track).
+// The loop's own map and image size for tracked poses (FastParams' 10 cm and 160 x 120 are too
+// coarse to track), with sensor noise.
+ExploreParams TrackedLoopParams(double max_time_s) {
   ExploreParams params = FastParams();
   params.voxel_size_m = 0.05f;
   params.image_width = 320;
   params.image_height = 240;
-  params.max_time_s = 60.0;
+  params.max_time_s = max_time_s;
   params.noise = true;
+  return params;
+}
+
+// The greedy planner's run of one robot in the small apartment.
+ExploreResult RunGreedy(const ExploreParams& params) {
+  const Scene& s = SmallApartment();
   const std::vector<Eigen::Vector2f> starts =
       ChooseStarts(s.plan, s.world.rooms, 1, params.robot.radius_m).value();
+  std::unique_ptr<LoadedPlanner> planner = Greedy();
+  EXPECT_TRUE(planner);
+  Result<ExploreResult> r = RunExplore(s.world, s.plan, starts, *planner, params, {});
+  EXPECT_TRUE(r.ok()) << r.status().message();
+  return r.ok() ? std::move(r).value() : ExploreResult{};
+}
+
+TEST(Explore, TrackedPosesFuseAtTheEstimateAndCountLostFrames) {
+  // --poses tracked: the start sweep is fused at the truth, every later frame at the tracker's
+  // estimate (close to the truth, not equal) or not at all (lost, counted); at the truth every
+  // frame is fused where it was taken.
+  ExploreParams params = TrackedLoopParams(60.0);
   auto run = [&](ExploreParams::Poses poses) {
     params.poses = poses;
-    std::unique_ptr<LoadedPlanner> planner = Greedy();
-    EXPECT_TRUE(planner);
-    Result<ExploreResult> r = RunExplore(s.world, s.plan, starts, *planner, params, {});
-    EXPECT_TRUE(r.ok()) << r.status().message();
-    return std::move(r).value();
+    return RunGreedy(params);
   };
   const ExploreResult truth = run(ExploreParams::Poses::kTruth);
   for (const ExploreFrame& f : truth.frames[0]) EXPECT_TRUE(f.T_W_C_fused.isApprox(f.T_W_C, 0.f));
   EXPECT_EQ(truth.frames_lost, 0u);
 
   const ExploreResult tracked = run(ExploreParams::Poses::kTracked);
-  size_t anchored = 0, estimated = 0;
+  size_t anchored = 0, estimated = 0, odometry = 0;
   for (const ExploreFrame& f : tracked.frames[0]) {
     const float error_m = (f.T_W_C_fused.translation() - f.T_W_C.translation()).norm();
-    if (f.residual_rms_m == 0.f) {
+    if (f.odometry) {  // no model in view: the noisy odometry's pose
+      EXPECT_LT(error_m, 0.25f);
+      ++odometry;
+    } else if (f.residual_rms_m == 0.f) {
       EXPECT_EQ(error_m, 0.f);  // the sweep
       ++anchored;
     } else {
@@ -599,12 +613,46 @@ TEST(Explore, TrackedPosesFuseAtTheEstimateAndCountLostFrames) {
   EXPECT_GE(anchored, 12u);  // a full turn of the sweep at least
   EXPECT_GE(estimated, 10u);
   EXPECT_LT(tracked.frames_lost, estimated);  // most frames track
+  RecordProperty("frames_odometry", std::to_string(odometry));
+  RecordProperty("frames_lost", std::to_string(tracked.frames_lost));
+  EXPECT_EQ(odometry, tracked.frames_odometry);
+  EXPECT_EQ(truth.frames_odometry, 0u);
   const TrackedPoseSummary summary = SummarizeTrackedPoses(tracked.frames);
   EXPECT_EQ(summary.frames, tracked.frames_fused);
   EXPECT_GT(summary.ate_rms_m, 0.0);
   EXPECT_LT(summary.ate_rms_m, 0.15);
   EXPECT_GT(summary.residual_mean_m, 0.0);
   EXPECT_LE(summary.residual_mean_m, summary.residual_p90_m + 1e-12);
+}
+
+// A start sweep looking down only, with the Xtion's 58° / 3 m camera, leaves the walls out of the
+// map: a frame that sees no model at all is fused at the odometry prior (its error is the
+// odometry's, no residual); with the option off no frame is.
+TEST(Explore, TrackedFramesWithoutAModelInViewAreFusedAtTheOdometry) {
+  ExploreParams params = TrackedLoopParams(40.0);
+  params.poses = ExploreParams::Poses::kTracked;
+  params.sweep_pitches_deg = {-55.f};
+  params.sweep_step_deg = 30.f;
+  params.robot.explorer.horizontal_fov_deg = 58.f;
+  params.robot.explorer.max_range_m = 3.f;
+  auto run = [&](bool odometry_without_model) {
+    params.odometry_without_model = odometry_without_model;
+    return RunGreedy(params);
+  };
+  const ExploreResult on = run(true), off = run(false);
+  RecordProperty("frames_odometry", std::to_string(on.frames_odometry));
+  RecordProperty("frames_fused_on", std::to_string(on.frames_fused));
+  RecordProperty("frames_fused_off", std::to_string(off.frames_fused));
+  EXPECT_EQ(off.frames_odometry, 0u);
+  EXPECT_GT(on.frames_odometry, 0u);
+  size_t odometry = 0;
+  for (const ExploreFrame& f : on.frames[0]) {
+    if (!f.odometry) continue;
+    ++odometry;
+    EXPECT_EQ(f.residual_rms_m, 0.f);
+    EXPECT_LT((f.T_W_C_fused.translation() - f.T_W_C.translation()).norm(), 0.25f);
+  }
+  EXPECT_EQ(odometry, on.frames_odometry);
 }
 
 TEST(Explore, PlannersSeeTheExplorerCamera) {

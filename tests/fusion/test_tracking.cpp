@@ -229,15 +229,22 @@ TEST(FrameTracker, SinglePlaneIsDegenerate) {
   EXPECT_EQ(r->T_W_C.matrix(), NominalAbovePlane().matrix());
 }
 
-TEST(FrameTracker, AllInvalidFrameIsLost) {
+// A frame of one depth everywhere (0: no valid pixel), tracked against the corner scene's model
+// from the nominal pose.
+TrackingResult TrackFlatFrame(float depth_m) {
   Fixture f(CornerScene(), false);
   FrameTracker tracker(f.camera, TrackingParams{});
   tracker.Reset(Nominal());
-  const DepthImage empty(f.camera.width, f.camera.height, 0.f);
-  const Result<TrackingResult> r = tracker.Track(empty, ColorImage(), f.volume);
-  ASSERT_TRUE(r.ok());
-  EXPECT_FALSE(r->ok);
-  EXPECT_FALSE(r->failure.empty());
+  const DepthImage flat(f.camera.width, f.camera.height, depth_m);
+  Result<TrackingResult> r = tracker.Track(flat, ColorImage(), f.volume);
+  EXPECT_TRUE(r.ok()) << r.status().message();
+  return r.ok() ? *r : TrackingResult{};
+}
+
+TEST(FrameTracker, AllInvalidFrameIsLost) {
+  const TrackingResult r = TrackFlatFrame(0.f);
+  EXPECT_FALSE(r.ok);
+  EXPECT_FALSE(r.failure.empty());
 }
 
 TEST(FrameTracker, EmptyModelIsLost) {
@@ -250,6 +257,16 @@ TEST(FrameTracker, EmptyModelIsLost) {
   ASSERT_TRUE(r.ok());
   EXPECT_FALSE(r->ok);
   EXPECT_NE(r->failure.find("correspondences"), std::string::npos) << r->failure;
+  EXPECT_TRUE(r->no_model);  // nothing to register against, not a surface out of place
+}
+
+// A surface the model does not hold, right in front of the camera: no correspondence either,
+// but the model is in view, so the frame did not align rather than saw nothing known.
+TEST(FrameTracker, UnknownSurfaceBeforeTheModelIsNotNoModel) {
+  const TrackingResult r = TrackFlatFrame(0.6f);
+  EXPECT_FALSE(r.ok);
+  EXPECT_NE(r.failure.find("correspondences"), std::string::npos) << r.failure;
+  EXPECT_FALSE(r.no_model);
 }
 
 TEST(FrameTracker, JumpBeyondMaxMotionIsLost) {
@@ -264,6 +281,7 @@ TEST(FrameTracker, JumpBeyondMaxMotionIsLost) {
   ASSERT_TRUE(r.ok());
   EXPECT_FALSE(r->ok);
   EXPECT_NE(r->failure.find("jump"), std::string::npos) << r->failure;
+  EXPECT_FALSE(r->no_model);
 }
 
 TEST(FrameTracker, RefusesMismatchedImages) {
