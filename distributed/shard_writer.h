@@ -1,5 +1,6 @@
 #pragma once
-// Writing a sharded map (io/sharded_map.h) from the ranks that hold it.
+// Writing a sharded map (io/sharded_map.h) from the ranks that hold it, and a run's final map
+// (sharded when split, else plain).
 #include <nlohmann/json.hpp>
 #include <string>
 

@@ -613,8 +613,6 @@ TEST(Explore, TrackedPosesFuseAtTheEstimateAndCountLostFrames) {
   EXPECT_GE(anchored, 12u);  // a full turn of the sweep at least
   EXPECT_GE(estimated, 10u);
   EXPECT_LT(tracked.frames_lost, estimated);  // most frames track
-  RecordProperty("frames_odometry", std::to_string(odometry));
-  RecordProperty("frames_lost", std::to_string(tracked.frames_lost));
   EXPECT_EQ(odometry, tracked.frames_odometry);
   EXPECT_EQ(truth.frames_odometry, 0u);
   const TrackedPoseSummary summary = SummarizeTrackedPoses(tracked.frames);
